@@ -1,0 +1,31 @@
+# All third-party dependencies come from Debian packages (scripts/install_deps.sh).
+find_package(Threads REQUIRED)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs features2d calib3d)
+find_package(Ceres REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+find_package(HDF5 REQUIRED COMPONENTS C)
+find_package(PCL REQUIRED COMPONENTS common kdtree search filters sample_consensus segmentation)
+
+# PCL's config adds global definitions and include dirs; keep them on an imported target instead.
+add_library(jvl_pcl INTERFACE)
+target_include_directories(jvl_pcl SYSTEM INTERFACE ${PCL_INCLUDE_DIRS})
+target_link_libraries(jvl_pcl INTERFACE ${PCL_LIBRARIES})
+
+add_library(jvl_hdf5 INTERFACE)
+target_include_directories(jvl_hdf5 SYSTEM INTERFACE ${HDF5_C_INCLUDE_DIRS} ${HDF5_INCLUDE_DIRS})
+target_link_libraries(jvl_hdf5 INTERFACE ${HDF5_C_LIBRARIES})
+target_compile_definitions(jvl_hdf5 INTERFACE ${HDF5_C_DEFINITIONS} ${HDF5_DEFINITIONS})
+
+add_library(jvl_opencv INTERFACE)
+target_include_directories(jvl_opencv SYSTEM INTERFACE ${OpenCV_INCLUDE_DIRS})
+target_link_libraries(jvl_opencv INTERFACE ${OpenCV_LIBS})
+
+if(JVL_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(JVL_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()

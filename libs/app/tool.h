@@ -1,0 +1,56 @@
+// The frame every tool's main() uses:
+//
+//   int main(int argc, char** argv) {
+//     jvl::app::Tool tool("vp_detect", "Detect up to 3 vanishing points per image.");
+//     VpOptions options;
+//     tool.cli().add_option("--min-length", options.min_length, "...")->capture_default_str();
+//     return tool.Run(argc, argv, [&] { ...; tool.Commit(writer) ...; });
+//   }
+//
+// Tool adds the common options (--version, --config, --threads, --log-level, --quiet), sets up
+// logging, turns every exception into one line "<tool>: error: <message>" on stderr with exit
+// code 1 (2 for bad command lines), and fills in the provenance of the artifacts it writes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/timer.h"
+#include "io/artifact.h"
+
+namespace jvl::app {
+
+class Tool {
+ public:
+  Tool(std::string name, std::string description);
+
+  CLI::App& cli() { return cli_; }
+  const std::string& name() const { return name_; }
+  int threads() const { return threads_; }  // Resolved (>= 1) once Run() has parsed.
+  bool quiet() const { return quiet_; }     // --quiet: no progress output.
+
+  // Parses argv and runs body. Returns the process exit code.
+  int Run(int argc, const char* const* argv, const std::function<void()>& body);
+
+  // Records an input file (path, size, content hash) for the provenance.
+  void AddInput(const std::string& path);
+  void SetDatasetId(const std::string& id) { dataset_id_ = id; }
+  // Provenance of this run so far: options, inputs, wall time and peak memory.
+  io::Provenance MakeProvenance() const;
+  // Options as JSON (name -> value as given or defaulted).
+  nlohmann::json OptionsJson() const;
+
+ private:
+  std::string name_;
+  CLI::App cli_;
+  int threads_ = 0;
+  std::string log_level_ = "info";
+  bool quiet_ = false;
+  std::vector<io::FileInfo> inputs_;
+  std::string dataset_id_;
+  Timer timer_;
+};
+
+}  // namespace jvl::app

@@ -1,0 +1,168 @@
+#include "io/kitti.h"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "core/check.h"
+#include "core/strings.h"
+#include "io/files.h"
+
+namespace jvl::io {
+
+PointCloud ParseVelodyneBin(const std::string& bytes, const std::string& name, size_t* dropped) {
+  JVL_CHECK(bytes.size() % 16 == 0, name << ": size " << bytes.size()
+                                         << " bytes is not a multiple of 16 (x, y, z, reflectance "
+                                            "as float32): truncated or not a KITTI scan");
+  const size_t n = bytes.size() / 16;
+  PointCloud cloud;
+  cloud.points.reserve(n);
+  cloud.intensity.reserve(n);
+  size_t bad = 0;
+  for (size_t i = 0; i < n; ++i) {
+    float v[4];
+    std::memcpy(v, bytes.data() + 16 * i, 16);
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+      ++bad;
+      continue;
+    }
+    cloud.points.emplace_back(v[0], v[1], v[2]);
+    cloud.intensity.push_back(std::isfinite(v[3]) ? v[3] : 0.0f);
+  }
+  if (dropped) *dropped = bad;
+  return cloud;
+}
+
+PointCloud ReadVelodyneBin(const std::string& path, size_t* dropped) {
+  JVL_CHECK(FileExists(path), path << ": scan file not found");
+  return ParseVelodyneBin(ReadTextFile(path), path, dropped);
+}
+
+void WriteVelodyneBin(const std::string& path, const PointCloud& cloud) {
+  std::string bytes(16 * cloud.size(), '\0');
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const float v[4] = {static_cast<float>(cloud.points[i].x()),
+                        static_cast<float>(cloud.points[i].y()),
+                        static_cast<float>(cloud.points[i].z()),
+                        cloud.intensity.empty() ? 0.0f : cloud.intensity[i]};
+    std::memcpy(bytes.data() + 16 * i, v, 16);
+  }
+  WriteTextFileAtomic(path, bytes);
+}
+
+Calibration ParseKittiCalibration(std::istream& in, const std::string& name) {
+  std::map<std::string, Eigen::Matrix<double, 3, 4>> entries;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string_view body = Trim(line);
+    if (body.empty()) continue;
+    const auto colon = body.find(':');
+    JVL_CHECK(colon != std::string_view::npos,
+              name << ":" << line_no << ": expected 'KEY: values', got '" << body << "'");
+    const std::string key(Trim(body.substr(0, colon)));
+    const auto tokens = SplitWhitespace(body.substr(colon + 1));
+    if (tokens.size() != 12) continue;  // Other entries (e.g. S_rect sizes) are not 3x4.
+    Eigen::Matrix<double, 3, 4> m;
+    for (int i = 0; i < 12; ++i) {
+      const auto v = ParseDouble(tokens[i]);
+      JVL_CHECK(v && std::isfinite(*v),
+                name << ":" << line_no << ": bad number '" << tokens[i] << "' in " << key);
+      m(i / 4, i % 4) = *v;
+    }
+    entries[key] = m;
+  }
+  Calibration calib;
+  for (int i = 0; i < 4; ++i) {
+    const std::string key = "P" + std::to_string(i);
+    JVL_CHECK(entries.count(key), name << ": missing " << key << " (3x4 projection matrix)");
+    calib.P[i] = entries[key];
+  }
+  JVL_CHECK(entries.count("Tr"), name << ": missing Tr (velodyne to cam0, 3x4)");
+  calib.cam0_from_velo = Rigid3d::FromMatrix(entries["Tr"]);
+  calib.Camera(0).Check();
+  return calib;
+}
+
+Calibration ReadKittiCalibration(const std::string& path) {
+  std::ifstream in(path);
+  JVL_CHECK(in.good(), path << ": calibration file not found");
+  return ParseKittiCalibration(in, path);
+}
+
+namespace {
+std::string FormatRow(const Eigen::Matrix<double, 3, 4>& m) {
+  std::string out;
+  for (int i = 0; i < 12; ++i) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.12e", m(i / 4, i % 4));
+    out += (i ? " " : "") + std::string(buf);
+  }
+  return out;
+}
+}  // namespace
+
+void WriteKittiCalibration(const std::string& path, const Calibration& calib) {
+  std::string out;
+  for (int i = 0; i < 4; ++i) out += "P" + std::to_string(i) + ": " + FormatRow(calib.P[i]) + "\n";
+  out += "Tr: " + FormatRow(calib.cam0_from_velo.Matrix3x4()) + "\n";
+  WriteTextFileAtomic(path, out);
+}
+
+std::vector<double> ParseKittiTimes(std::istream& in, const std::string& name) {
+  std::vector<double> times;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto body = Trim(line);
+    if (body.empty()) continue;
+    const auto v = ParseDouble(body);
+    JVL_CHECK(v && std::isfinite(*v), name << ":" << line_no << ": bad timestamp '" << body << "'");
+    times.push_back(*v);
+  }
+  return times;
+}
+
+std::vector<double> ReadKittiTimes(const std::string& path) {
+  std::ifstream in(path);
+  JVL_CHECK(in.good(), path << ": times file not found");
+  return ParseKittiTimes(in, path);
+}
+
+void WriteKittiTimes(const std::string& path, const std::vector<double>& times) {
+  std::string out;
+  for (double t : times) {
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.6e\n", t);
+    out += buf;
+  }
+  WriteTextFileAtomic(path, out);
+}
+
+cv::Mat ReadImage(const std::string& path, bool grayscale) {
+  JVL_CHECK(FileExists(path), path << ": image not found");
+  cv::Mat image = cv::imread(path, grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_UNCHANGED);
+  JVL_CHECK(!image.empty(), path << ": image does not decode (damaged or not an image)");
+  return image;
+}
+
+void WriteImage(const std::string& path, const cv::Mat& image) {
+  // OpenCV picks the encoder from the extension, so keep it on the temporary name.
+  const auto dot = path.find_last_of('.');
+  const std::string ext = dot == std::string::npos ? ".png" : path.substr(dot);
+  AtomicWrite(path, [&](const std::string& tmp) {
+    std::vector<uchar> buffer;
+    JVL_CHECK(cv::imencode(ext, image, buffer), path << ": cannot encode image");
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(buffer.data()),
+              static_cast<std::streamsize>(buffer.size()));
+    JVL_CHECK(out.good(), tmp << ": write failed");
+  });
+}
+
+}  // namespace jvl::io
