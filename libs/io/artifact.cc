@@ -322,6 +322,42 @@ std::vector<int64_t> H5Reader::Dims(const std::string& name) const {
   return std::vector<int64_t>(dims.begin(), dims.end());
 }
 
+std::string H5Reader::DatasetType(const std::string& name) const {
+  JVL_CHECK(Has(name), impl_->path << ": missing dataset '" << name << "'");
+  Handle ds(H5Dopen2(impl_->file, name.c_str(), H5P_DEFAULT), H5Dclose);
+  JVL_CHECK(ds.ok(), impl_->path << ": '" << name << "' is not a dataset");
+  Handle type(H5Dget_type(ds.get()), H5Tclose);
+  const size_t bits = 8 * H5Tget_size(type.get());
+  switch (H5Tget_class(type.get())) {
+    case H5T_FLOAT: return "float" + std::to_string(bits);
+    case H5T_INTEGER:
+      return (H5Tget_sign(type.get()) == H5T_SGN_NONE ? "uint" : "int") + std::to_string(bits);
+    case H5T_STRING: return "string";
+    default: return "other";
+  }
+}
+
+namespace {
+#if H5_VERSION_GE(1, 12, 0)
+using ObjectInfo = H5O_info2_t;
+#define JVL_H5_VISIT(file, op, data) H5Ovisit3(file, H5_INDEX_NAME, H5_ITER_INC, op, data, H5O_INFO_BASIC)
+#else
+using ObjectInfo = H5O_info_t;
+#define JVL_H5_VISIT(file, op, data) H5Ovisit(file, H5_INDEX_NAME, H5_ITER_INC, op, data)
+#endif
+herr_t CollectDataset(hid_t, const char* name, const ObjectInfo* info, void* data) {
+  if (info->type == H5O_TYPE_DATASET) static_cast<std::vector<std::string>*>(data)->push_back(name);
+  return 0;
+}
+}  // namespace
+
+std::vector<std::string> H5Reader::ListDatasets() const {
+  std::vector<std::string> names;
+  JVL_H5_VISIT(impl_->file, CollectDataset, &names);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
 template <typename T>
 std::vector<T> H5Reader::ReadArray(const std::string& name, int64_t expected_cols) const {
   const auto dims = Dims(name);

@@ -71,6 +71,10 @@ class H5Reader {
 
   bool Has(const std::string& name) const;
   std::vector<int64_t> Dims(const std::string& name) const;
+  // "float64", "float32", "int64", "int32", "uint8", ... of a dataset.
+  std::string DatasetType(const std::string& name) const;
+  // Names of all datasets ("group/name"), sorted.
+  std::vector<std::string> ListDatasets() const;
   // Reads a dataset converting to T; `expected_cols` > 0 checks a 2-D shape (N x cols).
   template <typename T>
   std::vector<T> ReadArray(const std::string& name, int64_t expected_cols = 0) const;

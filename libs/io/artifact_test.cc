@@ -1,0 +1,166 @@
+#include "io/artifact.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/check.h"
+#include "io/files.h"
+#include "io/schema_check.h"
+#include "io/trajectory_io.h"
+
+namespace jvl::io {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kSchemas = std::string(JVL_SOURCE_DIR) + "/schemas";
+
+class ArtifactTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("jvl_artifact_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string ErrorOf(const std::function<void()>& fn) {
+    try {
+      fn();
+    } catch (const Error& e) {
+      return e.message();
+    }
+    return "<no error>";
+  }
+  Trajectory Small() const {
+    Trajectory t;
+    for (int i = 0; i < 5; ++i) t.Append(i, Rigid3d(Eigen::Quaterniond::Identity(), {0, 0, 1.0 * i}));
+    return t;
+  }
+  fs::path dir_;
+};
+
+TEST_F(ArtifactTest, ArraysAttributesAndProvenanceRoundTrip) {
+  {
+    H5Writer w(Path("a.h5"), "demo", 3);
+    w.WriteArray<double>("group/sub/values", {1.5, 2.5, 3.5, 4.5, 5.5, 6.5}, {2, 3});
+    w.WriteArray<uint8_t>("bytes", {1, 2, 255});
+    w.WriteArray<int64_t>("empty", {});
+    w.WriteString("group/note", "hello");
+    w.WriteJson("meta", {{"k", 1}});
+    Provenance p;
+    p.tool = "demo_tool";
+    p.options = {{"alpha", "1.0"}};
+    p.inputs.push_back({"in.txt", 12, "fnv1a64:0"});
+    w.Commit(p);
+  }
+  H5Reader r(Path("a.h5"), "demo", 3);
+  EXPECT_EQ(r.Dims("group/sub/values"), (std::vector<int64_t>{2, 3}));
+  EXPECT_EQ(r.ReadArray<double>("group/sub/values", 3)[4], 5.5);
+  EXPECT_EQ(r.ReadArray<int32_t>("bytes")[2], 255);  // Converted on read.
+  EXPECT_TRUE(r.ReadArray<int64_t>("empty").empty());
+  EXPECT_EQ(r.DatasetType("bytes"), "uint8");
+  EXPECT_EQ(r.ReadString("group/note"), "hello");
+  EXPECT_EQ(r.ReadJson("meta")["k"], 1);
+  EXPECT_EQ(r.provenance()["tool"], "demo_tool");
+  EXPECT_EQ(r.provenance()["inputs"][0]["size"], 12);
+  EXPECT_FALSE(r.Has("nope"));
+  EXPECT_FALSE(r.Has("group/nope/deeper"));
+  EXPECT_EQ(r.ListDatasets(),
+            (std::vector<std::string>{"bytes", "empty", "group/sub/values"}));
+  EXPECT_THROW(r.ReadArray<double>("group/sub/values", 4), Error);
+}
+
+TEST_F(ArtifactTest, SchemaMismatchNamesFileExpectedAndFound) {
+  WriteTrajectoryArtifact(Path("t.h5"), Small(), Provenance{});
+  const std::string msg = ErrorOf([&] { H5Reader(Path("t.h5"), "vps", 1); });
+  EXPECT_NE(msg.find("t.h5: expected schema 'vps' version 1, found 'trajectory' version 1"),
+            std::string::npos) << msg;
+  EXPECT_NE(ErrorOf([&] { H5Reader(Path("t.h5"), "trajectory", 2); }).find("version 2"),
+            std::string::npos);
+}
+
+TEST_F(ArtifactTest, NotHdf5AndTruncatedFilesAreRejected) {
+  std::ofstream(Path("text.h5")) << "hello";
+  EXPECT_NE(ErrorOf([&] { H5Reader(Path("text.h5"), "trajectory", 1); }).find("not an HDF5"),
+            std::string::npos);
+  WriteTrajectoryArtifact(Path("full.h5"), Small(), Provenance{});
+  const std::string bytes = ReadTextFile(Path("full.h5"));
+  std::ofstream(Path("cut.h5"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  EXPECT_THROW(ReadTrajectory(Path("cut.h5")), Error);
+  EXPECT_NE(ErrorOf([&] { H5Reader(Path("none.h5"), "x", 1); }).find("not found"),
+            std::string::npos);
+}
+
+TEST_F(ArtifactTest, UncommittedWriterLeavesPreviousArtifactIntact) {
+  WriteTrajectoryArtifact(Path("t.h5"), Small(), Provenance{});
+  const std::string before = ReadTextFile(Path("t.h5"));
+  {
+    H5Writer w(Path("t.h5"), "trajectory", 1);
+    w.WriteArray<int64_t>("trajectory/frames", {1, 2});
+    // Destroyed without Commit(), as when an exception unwinds a tool.
+  }
+  EXPECT_EQ(ReadTextFile(Path("t.h5")), before);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
+}
+
+TEST_F(ArtifactTest, AtomicWriteKeepsOldFileWhenWriterFails) {
+  WriteTextFileAtomic(Path("x.txt"), "old");
+  EXPECT_THROW(AtomicWrite(Path("x.txt"),
+                           [](const std::string& tmp) {
+                             std::ofstream(tmp) << "partial";
+                             JVL_THROW("disk full");
+                           }),
+               Error);
+  EXPECT_EQ(ReadTextFile(Path("x.txt")), "old");
+}
+
+TEST_F(ArtifactTest, SameContentGivesSameBytesApartFromProvenance) {
+  Provenance p;
+  p.tool = "t";
+  WriteTrajectoryArtifact(Path("a.h5"), Small(), p);
+  WriteTrajectoryArtifact(Path("b.h5"), Small(), p);
+  H5Reader a(Path("a.h5"), "trajectory", 1), b(Path("b.h5"), "trajectory", 1);
+  EXPECT_EQ(a.ReadArray<double>("trajectory/poses"), b.ReadArray<double>("trajectory/poses"));
+  // Byte identity: with equal provenance strings the files are equal byte for byte.
+  const std::string ba = ReadTextFile(Path("a.h5")), bb = ReadTextFile(Path("b.h5"));
+  EXPECT_EQ(ba.size(), bb.size());
+}
+
+TEST_F(ArtifactTest, JsonArtifactRoundTripAndSchemaCheck) {
+  Provenance p;
+  p.tool = "t";
+  WriteJsonArtifact(Path("m.json"), "metrics", 1, {{"value", 2.5}}, p);
+  const auto j = ReadJsonArtifact(Path("m.json"), "metrics", 1);
+  EXPECT_EQ(j["value"], 2.5);
+  EXPECT_TRUE(CheckJsonAgainstSchema(j["provenance"], kSchemas + "/provenance.schema.json").empty());
+  EXPECT_NE(ErrorOf([&] { ReadJsonArtifact(Path("m.json"), "vps", 1); }).find("found 'metrics'"),
+            std::string::npos);
+  std::ofstream(Path("broken.json")) << "{\"schema\": ";
+  EXPECT_NE(ErrorOf([&] { ReadJsonArtifact(Path("broken.json"), "metrics", 1); })
+                .find("not valid JSON"),
+            std::string::npos);
+}
+
+TEST_F(ArtifactTest, TrajectoryArtifactMatchesItsSchema) {
+  Trajectory t = Small();
+  t.timestamps = {0, 0.1, 0.2, 0.3, 0.4};
+  Provenance p;
+  p.tool = "test";
+  WriteTrajectoryArtifact(Path("t.h5"), t, p);
+  const auto problems = CheckH5AgainstSchema(Path("t.h5"), kSchemas + "/trajectory.schema.json");
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  // And the checker does catch a wrong layout.
+  {
+    H5Writer w(Path("bad.h5"), "trajectory", 1);
+    w.WriteArray<int64_t>("trajectory/frames", {0, 1});
+    w.WriteArray<double>("trajectory/poses", std::vector<double>(3 * 7), {3, 7});
+    w.WriteArray<float>("extra", {1.0f});
+    w.Commit(p);
+  }
+  EXPECT_EQ(CheckH5AgainstSchema(Path("bad.h5"), kSchemas + "/trajectory.schema.json").size(), 2u);
+}
+
+}  // namespace
+}  // namespace jvl::io
