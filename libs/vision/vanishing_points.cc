@@ -65,14 +65,19 @@ double AngleResidual(const SphereSegment& s, const Eigen::Vector3d& d) {
   return std::atan2(s.normal.cross(c).norm(), std::abs(s.normal.dot(c)));
 }
 
-// MSAC support of d over the segments still unassigned.
+// MSAC support of d over the segments still unassigned. The hot loop of the hypothesis search:
+// it compares squared sines (sin ~ angle below the threshold) to avoid atan2 and square roots.
 double Support(const std::vector<SphereSegment>& segs, const std::vector<int>& label,
                const Eigen::Vector3d& d, double threshold) {
+  const double sin2_threshold = std::sin(threshold) * std::sin(threshold);
   double score = 0;
   for (size_t i = 0; i < segs.size(); ++i) {
     if (label[i] != -1 || !segs[i].valid) continue;
-    const double r = AngleResidual(segs[i], d) / threshold;
-    if (r < 1.0) score += segs[i].weight * (1.0 - r * r);
+    const Eigen::Vector3d c = segs[i].mid.cross(d);
+    const double c2 = c.squaredNorm();
+    if (c2 < 1e-24) continue;
+    const double r2 = segs[i].normal.cross(c).squaredNorm() / (c2 * sin2_threshold);
+    if (r2 < 1.0) score += segs[i].weight * (1.0 - r2);
   }
   return score;
 }

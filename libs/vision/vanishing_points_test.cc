@@ -152,8 +152,8 @@ TEST(VanishingPoints, RenderedImageGivesTheDrawnVp) {
     const double x = -400 + 130.0 * k;
     const double y = k % 2 ? cam.height + 10.0 : -10.0;
     const Eigen::Vector2d from(x, y), to = from + 0.8 * (vp - from);
-    cv::line(image, cv::Point2d(from.x(), from.y()), cv::Point2d(to.x(), to.y()),
-             cv::Scalar(230), 4, cv::LINE_AA);
+    cv::line(image, cv::Point2d(from.x(), from.y()), cv::Point2d(to.x(), to.y()), cv::Scalar(230),
+             4, cv::LINE_AA);
   }
   for (LineDetector detector : {LineDetector::kFld, LineDetector::kLsd}) {
     if (detector == LineDetector::kFld && !FastLineDetectorAvailable()) continue;
