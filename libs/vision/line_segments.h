@@ -23,7 +23,8 @@ std::string ToString(LineDetector detector);
 bool FastLineDetectorAvailable();
 
 struct LineSegmentOptions {
-  LineDetector detector = LineDetector::kFld;
+  // FLD when the build has opencv_ximgproc (faster, see docs/vp_detect.md), else LSD.
+  LineDetector detector = FastLineDetectorAvailable() ? LineDetector::kFld : LineDetector::kLsd;
   // The image is resized by this factor (area interpolation) before detection; endpoints are
   // mapped back to full resolution. 0.5 halves the time of FLD at some accuracy cost on KITTI
   // (p90 forward error 0.57 instead of 0.20 deg, docs/vp_detect.md).

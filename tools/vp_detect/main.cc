@@ -12,8 +12,9 @@
 
 int main(int argc, char** argv) {
   jvl::app::Tool tool("vp_detect", "Detect up to 3 vanishing points in every left image.");
-  std::string dataset_dir, format = "auto", frames = ":", output, csv, detector = "fld";
+  std::string dataset_dir, format = "auto", frames = ":", output, csv;
   jvl::VpDetectRunOptions run;
+  std::string detector = jvl::ToString(run.detect.segments.detector);
   jvl::LineSegmentOptions& seg = run.detect.segments;
   jvl::VpOptions& vp = run.detect.vp;
   CLI::App& cli = tool.cli();
