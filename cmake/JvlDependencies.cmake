@@ -2,6 +2,15 @@
 find_package(Threads REQUIRED)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(OpenCV REQUIRED COMPONENTS core imgproc imgcodecs features2d calib3d)
+# The Fast Line Detector lives in opencv_contrib's ximgproc (Debian: libopencv-contrib-dev).
+# Optional: without it the vision library offers the LSD line detector only.
+find_package(OpenCV QUIET COMPONENTS ximgproc)
+if(TARGET opencv_ximgproc)
+  set(JVL_HAVE_XIMGPROC ON)
+else()
+  set(JVL_HAVE_XIMGPROC OFF)
+  message(STATUS "opencv_ximgproc not found: only the LSD line detector is available")
+endif()
 find_package(Ceres REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(spdlog REQUIRED)
