@@ -8,7 +8,10 @@
 #include <set>
 
 #include "core/check.h"
+#include "direction/direction_plot.h"
 #include "direction/synthetic_vps.h"
+#include "io/files.h"
+#include "io/kitti.h"
 
 namespace jvl::direction {
 namespace {
@@ -27,8 +30,17 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 // U turns: the 1st and 3rd run in the same direction at different places, the 5th and 6th are
 // antiparallel; the 40 m one is below the 50 m the requirement is about.
 SyntheticPath TestPath() {
-  return MakePath({{150, 0}, {40, -90}, {100, 0}, {40, 90}, {120, 0}, {30, 90}, {40, 0},
-                   {30, 45}, {80, 0}, {50, 180}, {100, 0}});
+  return MakePath({{150, 0},
+                   {40, -90},
+                   {100, 0},
+                   {40, 90},
+                   {120, 0},
+                   {30, 90},
+                   {40, 0},
+                   {30, 45},
+                   {80, 0},
+                   {50, 180},
+                   {100, 0}});
 }
 
 // Straight segment holding most associations of each cluster (-1: mostly on turns).
@@ -86,9 +98,12 @@ TEST(DirectionCluster, GroundTruthPriorGivesOneAccurateClusterPerStraightSegment
   const DirectionClusterResult r =
       ClusterDirections(vps, path.truth, testing::KittiCamera(), DirectionClusterOptions());
   std::printf("GT prior: %d VPs, %d forward, %d level-1 clusters, %d kept, %d clusters, %d assoc\n",
-              r.stats.input_vps, r.stats.forward_kept, r.stats.level1_clusters,
-              r.stats.level1_kept, r.stats.level2_clusters, r.stats.associations);
+              r.stats.input_vps, r.stats.forward_kept, r.stats.level1_clusters, r.stats.level1_kept,
+              r.stats.level2_clusters, r.stats.associations);
   ExpectAtMostOnePerFrame(r);
+  io::CreateDirectories(std::string(JVL_BINARY_DIR) + "/direction_demo");
+  io::WriteImage(std::string(JVL_BINARY_DIR) + "/direction_demo/synthetic_gt_prior.png",
+                 RenderTopView(path.truth, r));
   EXPECT_NEAR(r.up.y(), -1.0, 1e-12);  // KITTI: world -y is up.
   const auto majority = MajoritySegment(path, r);
   for (size_t s = 0; s < path.segment_road.size(); ++s) {
@@ -143,12 +158,17 @@ TEST(DirectionCluster, DriftingPriorStillSeparatesRoadDirections) {
         sq_err += std::pow(yaw[a.frame], 2);
       }
       const double err = AngleDeg(c.direction, TrueDirection(path, r, c.id));
-      std::printf("  cluster %d: %3d frames, direction error %.3f deg, mean prior yaw %+.3f deg, "
-                  "RMS prior yaw %.3f deg\n",
-                  c.id, c.size, err, mean_yaw / kDeg, std::sqrt(sq_err / c.size) / kDeg);
+      std::printf(
+          "  cluster %d: %3d frames, direction error %.3f deg, mean prior yaw %+.3f deg, "
+          "RMS prior yaw %.3f deg\n",
+          c.id, c.size, err, mean_yaw / kDeg, std::sqrt(sq_err / c.size) / kDeg);
       EXPECT_NEAR(err, std::abs(mean_yaw) / kDeg, 0.3) << "cluster " << c.id;
     }
     ExpectNoMixing(path, r, max_yaw);
+    if (sigma == 0.1) {
+      io::WriteImage(std::string(JVL_BINARY_DIR) + "/direction_demo/synthetic_drift_prior.png",
+                     RenderTopView(prior, r));
+    }
     std::set<int> segments;
     for (const auto& [c, s] : MajoritySegment(path, r)) segments.insert(s);
     EXPECT_GE(segments.size(), 5u) << "sigma " << sigma;  // Five straight segments >= 50 m.

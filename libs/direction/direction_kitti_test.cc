@@ -9,6 +9,8 @@
 
 #include "direction/direction_cluster.h"
 #include "direction/synthetic_vps.h"
+#include "io/artifact.h"
+#include "io/directions_io.h"
 #include "io/files.h"
 #include "io/kitti.h"
 #include "io/trajectory_io.h"
@@ -39,16 +41,18 @@ TEST_F(Kitti04, OneDominantClusterCoversTheStraightRoad) {
   int dominant = 0;
   for (const auto& c : r.clusters) dominant = std::max(dominant, c.size);
   const double coverage = double(dominant) / gt_.size();
-  std::printf("KITTI 04: %zu frames, %d VPs, %d forward, %zu clusters, dominant %d frames (%.1f %%)\n",
-              gt_.size(), r.stats.input_vps, r.stats.forward_kept, r.clusters.size(), dominant,
-              100 * coverage);
+  std::printf(
+      "KITTI 04: %zu frames, %d VPs, %d forward, %zu clusters, dominant %d frames (%.1f %%)\n",
+      gt_.size(), r.stats.input_vps, r.stats.forward_kept, r.clusters.size(), dominant,
+      100 * coverage);
   for (const auto& c : r.clusters)
     std::printf("  cluster %d: %d frames %lld..%lld, std %.3f deg, d_w (%.4f %.4f %.4f)\n", c.id,
                 c.size, (long long)c.first_frame, (long long)c.last_frame, c.std_deg,
                 c.direction.x(), c.direction.y(), c.direction.z());
   EXPECT_GE(coverage, 0.8);
   // The dominant direction is the road's: start-to-end displacement on the ground.
-  Eigen::Vector3d road = gt_.world_from_cam.back().translation() - gt_.world_from_cam[0].translation();
+  Eigen::Vector3d road =
+      gt_.world_from_cam.back().translation() - gt_.world_from_cam[0].translation();
   road.y() = 0;
   for (const auto& c : r.clusters) {
     if (c.size != dominant) continue;
@@ -71,6 +75,44 @@ TEST_F(Kitti04, VIntervalReducesAssociations) {
   EXPECT_GT(counts[15], counts[50]);
   // A single cluster spanning ~270 frames keeps about 270 / K of them.
   EXPECT_NEAR(counts[50], 6, 2);
+}
+
+// Writes the projected VPs as a vps artifact (agreed layout) for running the tool end to end:
+//   build/direction_demo/kitti04_vps.h5
+TEST_F(Kitti04, WritesAVpsArtifactForTheTool) {
+  const std::string dir = std::string(JVL_BINARY_DIR) + "/direction_demo";
+  io::CreateDirectories(dir);
+  std::vector<int64_t> frame;
+  std::vector<int32_t> index, inliers;
+  std::vector<double> uv, direction, residual, score;
+  std::vector<uint8_t> forward;
+  for (const auto& vp : vps_) {
+    frame.push_back(vp.frame);
+    index.push_back(vp.vp_index);
+    uv.insert(uv.end(), {vp.uv.x(), vp.uv.y()});
+    direction.insert(direction.end(), vp.direction_cam.data(), vp.direction_cam.data() + 3);
+    inliers.push_back(0);
+    residual.push_back(0);
+    score.push_back(vp.score);
+    forward.push_back(vp.score == 1.0);  // The simulator gives the road VP score 1.
+  }
+  const int64_t m = int64_t(vps_.size());
+  io::H5Writer w(dir + "/kitti04_vps.h5", "vps", 1);
+  w.WriteArray("frames", gt_.frames);
+  w.WriteArray<double>("camera", {camera_.fx, camera_.fy, camera_.cx, camera_.cy,
+                                  double(camera_.width), double(camera_.height)});
+  w.WriteArray("vps/frame", frame);
+  w.WriteArray("vps/index", index);
+  w.WriteArray("vps/uv", uv, {m, 2});
+  w.WriteArray("vps/direction", direction, {m, 3});
+  w.WriteArray("vps/inliers", inliers);
+  w.WriteArray("vps/residual_deg", residual);
+  w.WriteArray("vps/score", score);
+  w.WriteArray("vps/is_forward", forward);
+  io::Provenance p;
+  p.tool = "direction_kitti_test";
+  w.Commit(p);
+  EXPECT_EQ(io::ReadVpsArtifact(dir + "/kitti04_vps.h5").vps.size(), vps_.size());
 }
 
 }  // namespace

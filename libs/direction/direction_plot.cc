@@ -37,6 +37,11 @@ cv::Mat RenderTopView(const Trajectory& prior, const DirectionClusterResult& res
       hi = hi.cwiseMax(p);
     }
   }
+  // Keep the shorter side at least half the longer one so a straight road stays readable.
+  const double longest = std::max(1.0, (hi - lo).maxCoeff());
+  const Eigen::Vector2d pad = ((0.5 * longest - (hi - lo).array()).max(0.0) / 2).matrix();
+  lo -= pad;
+  hi += pad;
   const Eigen::Vector2d extent = (hi - lo).cwiseMax(1.0);
   const int inner = options.size_px - 2 * options.margin_px;
   const double scale = inner / extent.maxCoeff();
