@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/check.h"
+#include "core/timer.h"
 #include "direction/direction_plot.h"
 #include "direction/synthetic_vps.h"
 #include "io/files.h"
@@ -256,6 +257,31 @@ TEST(DirectionCluster, RejectsBadOptions) {
   EXPECT_THROW(ClusterDirections({}, path.truth, testing::KittiCamera(), o), Error);
   EXPECT_TRUE(ClusterDirections({}, path.truth, testing::KittiCamera(), {}).clusters.empty());
   EXPECT_THROW(ClusterDirections({}, Trajectory(), testing::KittiCamera(), {}), Error);
+}
+
+}  // namespace
+}  // namespace jvl::direction
+
+namespace jvl::direction {
+namespace {
+
+TEST(DirectionCluster, FiveThousandFramesWithinBudget) {
+  // Straight runs of 150-450 m joined by 90 deg turns, 5000 frames 1 m apart (see also
+  // direction_benchmark); the budget is 5 s for 5000 frames.
+  std::vector<testing::PathSegment> segments;
+  for (int i = 0; segments.size() < 32; ++i) {
+    segments.push_back({150.0 + 100.0 * (i % 4), 0});
+    segments.push_back({40, i % 3 == 2 ? -90.0 : 90.0});
+  }
+  const SyntheticPath path = MakePath(segments);
+  ASSERT_GE(path.truth.size(), 5000u);
+  const auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});
+  const Timer timer;
+  const auto r = ClusterDirections(vps, path.truth, testing::KittiCamera(), {});
+  const double seconds = timer.ElapsedSeconds();
+  std::printf("%zu frames, %zu VPs: %.3f s, %zu clusters, %zu associations\n", path.truth.size(),
+              vps.size(), seconds, r.clusters.size(), r.associations.size());
+  EXPECT_LT(seconds, 5.0);
 }
 
 }  // namespace

@@ -13,8 +13,8 @@ namespace {
 template <typename T>
 void CheckRows(const std::string& path, const std::string& name, const std::vector<T>& v,
                size_t rows, size_t cols) {
-  JVL_CHECK(v.size() == rows * cols, path << ": " << name << " has " << v.size() / cols
-                                          << " rows, expected " << rows);
+  JVL_CHECK(v.size() == rows * cols,
+            path << ": " << name << " has " << v.size() / cols << " rows, expected " << rows);
 }
 
 }  // namespace

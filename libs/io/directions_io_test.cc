@@ -61,8 +61,8 @@ TEST_F(DirectionsIoTest, RoundTripMatchesSchemaAndCsv) {
 
 TEST_F(DirectionsIoTest, EmptyArtifactRoundTrips) {
   WriteDirectionsArtifact(Path("e.h5"), DirectionsData(), Provenance{});
-  EXPECT_TRUE(CheckH5AgainstSchema(Path("e.h5"), std::string(JVL_SOURCE_DIR) +
-                                                     "/schemas/directions.schema.json")
+  EXPECT_TRUE(CheckH5AgainstSchema(Path("e.h5"),
+                                   std::string(JVL_SOURCE_DIR) + "/schemas/directions.schema.json")
                   .empty());
   EXPECT_TRUE(ReadDirectionsArtifact(Path("e.h5")).associations.empty());
 }
