@@ -1,0 +1,288 @@
+#include "direction/direction_cluster.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "core/check.h"
+#include "core/timer.h"
+#include "direction/direction_plot.h"
+#include "direction/synthetic_vps.h"
+#include "io/files.h"
+#include "io/kitti.h"
+
+namespace jvl::direction {
+namespace {
+
+using testing::MakePath;
+using testing::PathSegment;
+using testing::SyntheticPath;
+
+constexpr double kDeg = M_PI / 180.0;
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) / kDeg;
+}
+
+// Straight segments of 150, 100, 120, 40, 80 and 100 m joined by right, left, left, 45 deg and
+// U turns: the 1st and 3rd run in the same direction at different places, the 5th and 6th are
+// antiparallel; the 40 m one is below the 50 m the requirement is about.
+SyntheticPath TestPath() {
+  return MakePath({{150, 0},
+                   {40, -90},
+                   {100, 0},
+                   {40, 90},
+                   {120, 0},
+                   {30, 90},
+                   {40, 0},
+                   {30, 45},
+                   {80, 0},
+                   {50, 180},
+                   {100, 0}});
+}
+
+// Straight segment holding most associations of each cluster (-1: mostly on turns).
+std::map<int, int> MajoritySegment(const SyntheticPath& path, const DirectionClusterResult& r) {
+  std::map<int, std::map<int, int>> counts;
+  for (const auto& a : r.associations) ++counts[a.cluster][path.segment[a.frame]];
+  std::map<int, int> out;
+  for (const auto& [c, per] : counts) {
+    int best = -1, n = 0;
+    for (const auto& [s, k] : per)
+      if (k > n) best = s, n = k;
+    out[c] = path.segment_road[best].norm() > 0 ? best : -1;
+  }
+  return out;
+}
+
+// True road direction of a cluster: mean tangent over its association frames.
+Eigen::Vector3d TrueDirection(const SyntheticPath& path, const DirectionClusterResult& r, int c) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& a : r.associations)
+    if (a.cluster == c) sum += path.road[a.frame];
+  return sum.normalized();
+}
+
+void ExpectAtMostOnePerFrame(const DirectionClusterResult& r) {
+  std::set<int64_t> frames;
+  for (const auto& a : r.associations) EXPECT_TRUE(frames.insert(a.frame).second) << a.frame;
+}
+
+// Every association of a cluster lies on its majority straight segment or on a turn next to it
+// where the true road is within 10 deg (+ the prior's yaw error there) of the cluster direction;
+// at most 10 % on turns.
+void ExpectNoMixing(const SyntheticPath& path, const DirectionClusterResult& r,
+                    double max_yaw_deg) {
+  const auto majority = MajoritySegment(path, r);
+  for (const auto& c : r.clusters) {
+    const int own = majority.at(c.id);
+    EXPECT_GE(own, 0) << "cluster " << c.id << " lives on a turn";
+    int on_turns = 0;
+    for (const auto& a : r.associations) {
+      if (a.cluster != c.id) continue;
+      const int seg = path.segment[a.frame];
+      const bool straight = path.segment_road[seg].norm() > 0;
+      EXPECT_TRUE(!straight || seg == own) << "cluster " << c.id << " frame " << a.frame;
+      EXPECT_LT(AngleDeg(path.road[a.frame], c.direction), 10.0 + max_yaw_deg) << a.frame;
+      on_turns += !straight;
+    }
+    EXPECT_LE(on_turns, c.size / 10) << "cluster " << c.id;
+  }
+}
+
+TEST(DirectionCluster, GroundTruthPriorGivesOneAccurateClusterPerStraightSegment) {
+  const SyntheticPath path = TestPath();
+  const auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});
+  const DirectionClusterResult r =
+      ClusterDirections(vps, path.truth, testing::KittiCamera(), DirectionClusterOptions());
+  std::printf("GT prior: %d VPs, %d forward, %d level-1 clusters, %d kept, %d clusters, %d assoc\n",
+              r.stats.input_vps, r.stats.forward_kept, r.stats.level1_clusters, r.stats.level1_kept,
+              r.stats.level2_clusters, r.stats.associations);
+  ExpectAtMostOnePerFrame(r);
+  io::CreateDirectories(std::string(JVL_BINARY_DIR) + "/direction_demo");
+  io::WriteImage(std::string(JVL_BINARY_DIR) + "/direction_demo/synthetic_gt_prior.png",
+                 RenderTopView(path.truth, r));
+  EXPECT_NEAR(r.up.y(), -1.0, 1e-12);  // KITTI: world -y is up.
+  const auto majority = MajoritySegment(path, r);
+  for (size_t s = 0; s < path.segment_road.size(); ++s) {
+    if (path.segment_road[s].norm() == 0) continue;
+    int frames = 0;
+    for (int seg : path.segment) frames += seg == int(s);
+    double best = 180;
+    int size = 0;
+    for (const auto& c : r.clusters) {
+      if (majority.at(c.id) != int(s)) continue;
+      const double err = AngleDeg(c.direction, path.segment_road[s]);
+      if (err < best) best = err, size = c.size;
+    }
+    std::printf("  segment %zu: %3d m, cluster error %.3f deg, %d associations\n", s, frames, best,
+                size);
+    if (frames >= 50) {
+      EXPECT_LT(best, 0.5) << "segment " << s;
+    }
+  }
+  // No cluster mixes two road directions: no association on another straight segment than the
+  // cluster's own (the closest pair of straight segments differs by 45 deg), few on turns.
+  ExpectNoMixing(path, r, 0.0);
+  // Segments 0 and 4 run in the same direction at different places: separate clusters.
+  std::set<int> on0, on4;
+  for (const auto& c : r.clusters) {
+    if (majority.at(c.id) == 0) on0.insert(c.id);
+    if (majority.at(c.id) == 4) on4.insert(c.id);
+  }
+  for (int c : on0) EXPECT_EQ(on4.count(c), 0u);
+}
+
+TEST(DirectionCluster, DriftingPriorStillSeparatesRoadDirections) {
+  const SyntheticPath path = TestPath();
+  const auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});
+  for (double sigma : {0.01, 0.03, 0.1}) {
+    std::vector<double> yaw;
+    const Trajectory prior = testing::DriftPrior(path.truth, sigma, 21, &yaw);
+    double max_yaw = 0;
+    for (double y : yaw) max_yaw = std::max(max_yaw, std::abs(y) / kDeg);
+    const DirectionClusterResult r =
+        ClusterDirections(vps, prior, testing::KittiCamera(), DirectionClusterOptions());
+    ExpectAtMostOnePerFrame(r);
+    std::printf("yaw walk %.2f deg/frame (max prior yaw error %.2f deg): %zu clusters\n", sigma,
+                max_yaw, r.clusters.size());
+    for (const auto& c : r.clusters) {
+      // The cluster direction is the mean of R_prior d over its frames, so its error follows
+      // the mean prior yaw error there.
+      double mean_yaw = 0, sq_err = 0;
+      for (const auto& a : r.associations) {
+        if (a.cluster != c.id) continue;
+        mean_yaw += yaw[a.frame] / c.size;
+        sq_err += std::pow(yaw[a.frame], 2);
+      }
+      const double err = AngleDeg(c.direction, TrueDirection(path, r, c.id));
+      std::printf(
+          "  cluster %d: %3d frames, direction error %.3f deg, mean prior yaw %+.3f deg, "
+          "RMS prior yaw %.3f deg\n",
+          c.id, c.size, err, mean_yaw / kDeg, std::sqrt(sq_err / c.size) / kDeg);
+      EXPECT_NEAR(err, std::abs(mean_yaw) / kDeg, 0.3) << "cluster " << c.id;
+    }
+    ExpectNoMixing(path, r, max_yaw);
+    if (sigma == 0.1) {
+      io::WriteImage(std::string(JVL_BINARY_DIR) + "/direction_demo/synthetic_drift_prior.png",
+                     RenderTopView(prior, r));
+    }
+    std::set<int> segments;
+    for (const auto& [c, s] : MajoritySegment(path, r)) segments.insert(s);
+    EXPECT_GE(segments.size(), 5u) << "sigma " << sigma;  // Five straight segments >= 50 m.
+  }
+}
+
+TEST(DirectionCluster, VIntervalKeepsAssociationsAtLeastKFramesApart) {
+  const SyntheticPath path = TestPath();
+  const auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});
+  DirectionClusterOptions o;
+  std::vector<int> counts;
+  for (int k : {0, 5, 15, 50}) {
+    o.v_interval = k;
+    const DirectionClusterResult r = ClusterDirections(vps, path.truth, testing::KittiCamera(), o);
+    counts.push_back(r.stats.associations);
+    EXPECT_EQ(r.stats.associations_before_interval, counts.front());
+    std::map<int, int64_t> last;
+    for (const auto& a : r.associations) {
+      if (last.count(a.cluster) && k > 0) {
+        EXPECT_GE(a.frame - last[a.cluster], k);
+      }
+      last[a.cluster] = a.frame;
+    }
+    std::printf("V_interval %2d: %d associations in %zu clusters\n", k, counts.back(),
+                r.clusters.size());
+  }
+  EXPECT_GT(counts[0], counts[1]);
+  EXPECT_GT(counts[1], counts[2]);
+  EXPECT_GT(counts[2], counts[3]);
+  EXPECT_GT(counts[3], 0);
+}
+
+TEST(DirectionCluster, DownsampleKeepsTheFirstFramePerClusterAndSpacing) {
+  std::vector<DirectionAssociation> rows;
+  for (int f = 0; f < 20; ++f) {
+    DirectionAssociation a;
+    a.frame = f;
+    a.cluster = f % 2;
+    rows.push_back(a);
+  }
+  const auto kept = DownsampleAssociations(rows, 5);
+  std::vector<int64_t> frames;
+  for (const auto& a : kept) frames.push_back(a.frame);
+  EXPECT_EQ(frames, (std::vector<int64_t>{0, 1, 6, 7, 12, 13, 18, 19}));
+  EXPECT_EQ(DownsampleAssociations(rows, 0).size(), 20u);
+}
+
+TEST(DirectionCluster, IsDeterministicAndSkipsFramesWithoutPrior) {
+  const SyntheticPath path = TestPath();
+  auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});
+  VpObservation stray;
+  stray.frame = 100000;
+  stray.direction_cam = {0, 0, 1};
+  vps.push_back(stray);
+  const auto a = ClusterDirections(vps, path.truth, testing::KittiCamera(), {});
+  const auto b = ClusterDirections(vps, path.truth, testing::KittiCamera(), {});
+  EXPECT_EQ(a.stats.missing_prior, 1);
+  ASSERT_EQ(a.associations.size(), b.associations.size());
+  for (size_t i = 0; i < a.associations.size(); ++i) {
+    EXPECT_EQ(a.associations[i].frame, b.associations[i].frame);
+    EXPECT_EQ(a.associations[i].cluster, b.associations[i].cluster);
+  }
+  ASSERT_EQ(a.clusters.size(), b.clusters.size());
+  for (size_t i = 0; i < a.clusters.size(); ++i)
+    EXPECT_EQ(a.clusters[i].direction, b.clusters[i].direction);
+}
+
+TEST(DirectionCluster, DirectionFromPixelWhenTheRayIsMissing) {
+  const SyntheticPath path = MakePath({{120, 0}});
+  auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});
+  for (auto& vp : vps)
+    if (vp.uv.allFinite()) vp.direction_cam.setConstant(std::nan(""));
+  const auto r = ClusterDirections(vps, path.truth, testing::KittiCamera(), {});
+  ASSERT_EQ(r.clusters.size(), 1u);
+  EXPECT_LT(AngleDeg(r.clusters[0].direction, Eigen::Vector3d::UnitZ()), 0.5);
+}
+
+TEST(DirectionCluster, RejectsBadOptions) {
+  const SyntheticPath path = MakePath({{60, 0}});
+  DirectionClusterOptions o;
+  o.v_interval = -1;
+  EXPECT_THROW(ClusterDirections({}, path.truth, testing::KittiCamera(), o), Error);
+  o = DirectionClusterOptions();
+  o.bandwidth1_deg = 0;
+  EXPECT_THROW(ClusterDirections({}, path.truth, testing::KittiCamera(), o), Error);
+  EXPECT_TRUE(ClusterDirections({}, path.truth, testing::KittiCamera(), {}).clusters.empty());
+  EXPECT_THROW(ClusterDirections({}, Trajectory(), testing::KittiCamera(), {}), Error);
+}
+
+}  // namespace
+}  // namespace jvl::direction
+
+namespace jvl::direction {
+namespace {
+
+TEST(DirectionCluster, FiveThousandFramesWithinBudget) {
+  // Straight runs of 150-450 m joined by 90 deg turns, 5000 frames 1 m apart (see also
+  // direction_benchmark); the budget is 5 s for 5000 frames.
+  std::vector<testing::PathSegment> segments;
+  for (int i = 0; segments.size() < 32; ++i) {
+    segments.push_back({150.0 + 100.0 * (i % 4), 0});
+    segments.push_back({40, i % 3 == 2 ? -90.0 : 90.0});
+  }
+  const SyntheticPath path = MakePath(segments);
+  ASSERT_GE(path.truth.size(), 5000u);
+  const auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});
+  const Timer timer;
+  const auto r = ClusterDirections(vps, path.truth, testing::KittiCamera(), {});
+  const double seconds = timer.ElapsedSeconds();
+  std::printf("%zu frames, %zu VPs: %.3f s, %zu clusters, %zu associations\n", path.truth.size(),
+              vps.size(), seconds, r.clusters.size(), r.associations.size());
+  EXPECT_LT(seconds, 5.0);
+}
+
+}  // namespace
+}  // namespace jvl::direction

@@ -1,0 +1,68 @@
+// The "directions" artifact (schema "directions" v1, schemas/directions.schema.json): direction
+// priors d_w (clusters) and the VPs associated to them (at most one per frame); its CSV export;
+// and a minimal reader of the "vps" artifact (schema "vps" v1) for direction_cluster.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "io/artifact.h"
+
+namespace jvl::io {
+
+struct VpRow {
+  int64_t frame = 0;
+  int32_t index = 0;
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();         // NaN if at infinity.
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // Unit, camera frame, z >= 0.
+  bool is_forward = false;
+  double score = 0;
+};
+
+struct VpsData {
+  std::vector<int64_t> frames;          // All processed frames.
+  std::optional<PinholeCamera> camera;  // From "camera" (fx fy cx cy width height) if present.
+  std::vector<VpRow> vps;
+};
+
+// Reads frames, camera and vps/{frame,index,uv,direction,is_forward,score} of a vps artifact.
+// Throws naming the file on a wrong schema or inconsistent row counts.
+VpsData ReadVpsArtifact(const std::string& path);
+
+struct DirectionClusterRow {
+  int32_t id = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // Unit, world.
+  double std_deg = 0;
+  int32_t size = 0;
+  int64_t first_frame = 0, last_frame = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+};
+
+struct DirectionAssociationRow {
+  int64_t frame = 0;
+  int32_t vp_index = 0;
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  int32_t cluster = 0;
+};
+
+struct DirectionsData {
+  std::vector<DirectionClusterRow> clusters;
+  std::vector<DirectionAssociationRow> associations;
+  nlohmann::json summary = nlohmann::json::object();  // Counts per step, ground frame, ...
+};
+
+void WriteDirectionsArtifact(const std::string& path, const DirectionsData& data,
+                             const Provenance& provenance);
+// Checks schema, shapes, that cluster ids exist and that no frame appears twice.
+DirectionsData ReadDirectionsArtifact(const std::string& path);
+
+// "frame,cluster,u,v,dwx,dwy,dwz": one row per association, d_w of its cluster.
+std::string FormatDirectionsCsv(const DirectionsData& data);
+void WriteDirectionsCsv(const std::string& path, const DirectionsData& data);
+
+}  // namespace jvl::io

@@ -1,0 +1,147 @@
+// direction_cluster: direction priors from vanishing points and a prior trajectory (Sec. 4.3,
+// Algorithm 2 of the supplement). Reads vps.h5 + any trajectory, writes directions.h5 and
+// optionally a CSV of the associations and a top-view PNG.
+#include <spdlog/spdlog.h>
+
+#include "app/tool.h"
+#include "core/check.h"
+#include "core/strings.h"
+#include "direction/direction_cluster.h"
+#include "direction/direction_plot.h"
+#include "io/dataset.h"
+#include "io/directions_io.h"
+#include "io/kitti.h"
+#include "io/trajectory_io.h"
+
+namespace {
+
+using namespace jvl;
+
+Eigen::Vector3d ParseUp(const std::string& text) {
+  if (text == "auto") return Eigen::Vector3d::Zero();
+  const auto parts = SplitWhitespace(text, /*comma=*/true);
+  JVL_CHECK(parts.size() == 3, "--up: expected 'auto' or 'x,y,z', got '" << text << "'");
+  Eigen::Vector3d up;
+  for (int i = 0; i < 3; ++i) {
+    const auto v = ParseDouble(parts[i]);
+    JVL_CHECK(v, "--up: '" << parts[i] << "' is not a number");
+    up[i] = *v;
+  }
+  JVL_CHECK(up.norm() > 0, "--up: the vector must not be zero");
+  return up;
+}
+
+std::vector<direction::VpObservation> ToObservations(const io::VpsData& data) {
+  std::vector<direction::VpObservation> out;
+  for (const auto& r : data.vps)
+    out.push_back({r.frame, r.index, r.uv, r.direction, r.is_forward, r.score});
+  return out;
+}
+
+io::DirectionsData ToData(const direction::DirectionClusterResult& r, int v_interval) {
+  io::DirectionsData d;
+  for (const auto& c : r.clusters)
+    d.clusters.push_back(
+        {c.id, c.direction, c.std_deg, c.size, c.first_frame, c.last_frame, c.centroid});
+  for (const auto& a : r.associations)
+    d.associations.push_back({a.frame, a.vp_index, a.uv, a.cluster});
+  const auto& s = r.stats;
+  auto vec = [](const Eigen::Vector3d& v) { return std::vector<double>{v.x(), v.y(), v.z()}; };
+  d.summary = {{"input_vps", s.input_vps},
+               {"missing_prior", s.missing_prior},
+               {"forward_kept", s.forward_kept},
+               {"level1_clusters", s.level1_clusters},
+               {"level1_kept", s.level1_kept},
+               {"window_kept", s.window_kept},
+               {"level2_clusters", s.level2_clusters},
+               {"associations_before_interval", s.associations_before_interval},
+               {"associations", s.associations},
+               {"v_interval", v_interval},
+               {"up", vec(r.up)},
+               {"ground_e1", vec(r.ground_e1)},
+               {"ground_e2", vec(r.ground_e2)}};
+  return d;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  app::Tool tool("direction_cluster",
+                 "Direction priors d_w by bi-level mean-shift of the vanishing directions "
+                 "R_wc K^-1 v (Algorithm 2), with at most one VP per frame.");
+  std::string vps_path, prior_path, dataset, output, csv, plot, up = "auto";
+  direction::DirectionClusterOptions o;
+  auto& cli = tool.cli();
+  cli.add_option("--vps", vps_path, "vps artifact (vp_detect)")->required();
+  cli.add_option("--prior", prior_path, "Prior trajectory (.h5 artifact, KITTI or TUM text)")
+      ->required();
+  cli.add_option("-d,--dataset", dataset, "Dataset folder for the intrinsics if vps has no camera");
+  cli.add_option("-o,--output", output, "directions artifact to write")->required();
+  cli.add_option("--csv", csv, "CSV of the associations: frame,cluster,u,v,dwx,dwy,dwz");
+  cli.add_option("--plot", plot, "Top-view PNG of the trajectory and the clusters");
+  cli.add_option("--v-interval", o.v_interval,
+                 "V_interval: keep associations of a cluster >= K frames apart (0 = all)")
+      ->capture_default_str();
+  cli.add_option("--up", up, "World up vector x,y,z, or auto = -y of the first prior camera")
+      ->capture_default_str();
+  cli.add_option("--th-f", o.forward_max_angle_deg,
+                 "Th_f: max angle (deg) between a VP's ground projection and the motion")
+      ->capture_default_str();
+  cli.add_option("--forward-baseline", o.forward_baseline_m,
+                 "Path length (m) over which the motion direction is measured")
+      ->capture_default_str();
+  cli.add_option("--min-ground", o.min_ground_component, "Min ground component of a VP direction")
+      ->capture_default_str();
+  cli.add_flag("--use-forward-flag", o.use_forward_flag,
+               "Also require vp_detect's is_forward flag");
+  cli.add_option("--bandwidth1", o.bandwidth1_deg, "First-level mean-shift bandwidth (deg)")
+      ->capture_default_str();
+  cli.add_option("--max-member-angle", o.max_member_angle_deg,
+                 "Max angle (deg) of a member to its first-level mode")
+      ->capture_default_str();
+  cli.add_option("--slope-subset", o.slope_subset_deg, "Slope gap (deg) that separates subsets")
+      ->capture_default_str();
+  cli.add_option("--th-delta", o.max_std_deg, "Th_delta: max cluster std (deg)")
+      ->capture_default_str();
+  cli.add_option("--th-n", o.min_size, "Th_n: min cluster size")->capture_default_str();
+  cli.add_option("--th-m", o.clusters_per_window, "Th_m: clusters kept per window")
+      ->capture_default_str();
+  cli.add_option("--th-l", o.window_length_m, "Th_l: window length (m of path)")
+      ->capture_default_str();
+  cli.add_option("--bandwidth2", o.bandwidth2_m, "Second-level mean-shift bandwidth (m)")
+      ->capture_default_str();
+  cli.add_option("--link-gap", o.link_gap_m,
+                 "Join second-level sub-clusters closer than this along the path (m, 0 = off)")
+      ->capture_default_str();
+  return tool.Run(argc, argv, [&] {
+    o.up = ParseUp(up);
+    o.Check();
+    const io::VpsData vps = io::ReadVpsArtifact(vps_path);
+    tool.AddInput(vps_path);
+    const Trajectory prior = io::ReadTrajectory(prior_path);
+    tool.AddInput(prior_path);
+    PinholeCamera camera;
+    if (vps.camera) {
+      camera = *vps.camera;
+    } else {
+      JVL_CHECK(!dataset.empty(), vps_path << " has no camera; pass --dataset for the intrinsics");
+      const auto ds = io::OpenDataset(dataset);
+      camera = ds->calibration().Camera(0);
+      tool.SetDatasetId(ds->id());
+    }
+    const auto result = direction::ClusterDirections(ToObservations(vps), prior, camera, o);
+    if (result.stats.missing_prior > 0)
+      spdlog::warn("{} VPs skipped: their frames are not in the prior {}",
+                   result.stats.missing_prior, prior_path);
+    const io::DirectionsData data = ToData(result, o.v_interval);
+    io::WriteDirectionsArtifact(output, data, tool.MakeProvenance());
+    if (!csv.empty()) io::WriteDirectionsCsv(csv, data);
+    if (!plot.empty()) io::WriteImage(plot, direction::RenderTopView(prior, result));
+    const auto& s = result.stats;
+    spdlog::info(
+        "{} VPs, {} pass the forward filter, {} first-level clusters ({} kept, {} after "
+        "Th_m/Th_l), {} direction priors, {} associations ({} before V_interval {})",
+        s.input_vps, s.forward_kept, s.level1_clusters, s.level1_kept, s.window_kept,
+        s.level2_clusters, s.associations, s.associations_before_interval, o.v_interval);
+  });
+}
