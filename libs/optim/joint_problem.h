@@ -107,7 +107,7 @@ struct JointProblem {
 JointProblem BuildJointProblem(const JointProblemInput& input, const JointProblemOptions& options);
 
 struct SolveOptions {
-  int max_iterations = 50;
+  int max_iterations = 100;
   int threads = 1;
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;

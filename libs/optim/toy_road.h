@@ -25,7 +25,8 @@ struct ToyRoad {
   JointProblemInput input;
 };
 
-inline ToyRoad MakeToyRoad(bool with_directions, int num_keyframes = kToyKeyframes) {
+inline ToyRoad MakeToyRoad(bool with_directions, int num_keyframes = kToyKeyframes,
+                           double yaw_drift_per_step = kYawDriftPerStep) {
   std::mt19937 rng(42);
   std::normal_distribution<double> pixel_noise(0.0, 0.5);
   std::normal_distribution<double> range_noise(0.0, 0.01);
@@ -33,7 +34,7 @@ inline ToyRoad MakeToyRoad(bool with_directions, int num_keyframes = kToyKeyfram
   ToyRoad toy;
   JointProblemInput& in = toy.input;
   in.camera = KittiLikeCamera();
-  const Rigid3d drift(ExpSO3(Eigen::Vector3d(0, kYawDriftPerStep, 0)), Eigen::Vector3d::Zero());
+  const Rigid3d drift(ExpSO3(Eigen::Vector3d(0, yaw_drift_per_step, 0)), Eigen::Vector3d::Zero());
   for (int k = 0; k < num_keyframes; ++k) {
     toy.truth[k] = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, kStep * k));
     in.poses[k] =
