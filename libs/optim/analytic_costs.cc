@@ -1,0 +1,94 @@
+#include "optim/analytic_costs.h"
+
+#include <Eigen/Geometry>
+
+namespace jvl::optim {
+namespace {
+
+Eigen::Matrix3d SkewOf(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+// d/d[u w] of v + 2 sign*w (u x v) + 2 u x (u x v); sign = +1 for R(q) v, -1 for R(q)^T v
+// (conjugation flips u, and u x (u x v) is even in u).
+Eigen::Matrix<double, 3, 4> RotateJacobianSigned(const double* q, const Eigen::Vector3d& v,
+                                                 double sign) {
+  const Eigen::Vector3d u(q[0], q[1], q[2]);
+  const double w = q[3];
+  Eigen::Matrix<double, 3, 4> j;
+  j.leftCols<3>() =
+      -2.0 * sign * w * SkewOf(v) +
+      2.0 * (u.dot(v) * Eigen::Matrix3d::Identity() + u * v.transpose() - 2.0 * v * u.transpose());
+  j.col(3) = 2.0 * sign * u.cross(v);
+  return j;
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 3, 4> RotateJacobian(const double* q_xyzw, const Eigen::Vector3d& v) {
+  return RotateJacobianSigned(q_xyzw, v, 1.0);
+}
+
+Eigen::Matrix<double, 3, 4> InverseRotateJacobian(const double* q_xyzw, const Eigen::Vector3d& v) {
+  return RotateJacobianSigned(q_xyzw, v, -1.0);
+}
+
+// r = s (n . R_wc^T (p_w - t_wc) - n . c_p_y) = s (g . (p_w - t_wc) - n . c_p_y), g = R_wc n,
+// p_w = R_wn p_x + t_wn. Hence dr/dt_wn = s g^T, dr/dt_wc = -s g^T,
+// dr/dq_n = s g^T d(R_wn p_x)/dq_n, dr/dq_c = s n^T d(R_wc^T w)/dq_c with w = p_w - t_wc.
+bool PointToImlsAnalyticCost::Evaluate(double const* const* parameters, double* residuals,
+                                       double** jacobians) const {
+  const double* pose_n = parameters[0];
+  const double* pose_c = parameters[1];
+  const Eigen::Map<const Eigen::Quaterniond> q_wn(pose_n);
+  const Eigen::Map<const Eigen::Vector3d> t_wn(pose_n + 4);
+  const Eigen::Map<const Eigen::Quaterniond> q_wc(pose_c);
+  const Eigen::Map<const Eigen::Vector3d> t_wc(pose_c + 4);
+  const Eigen::Vector3d w = q_wn * p_x_ + t_wn - t_wc;
+  const Eigen::Vector3d g = q_wc * c_normal_;
+  const double s = sqrt_information_;
+  residuals[0] = s * (g.dot(w) - c_normal_.dot(c_p_y_));
+  if (jacobians == nullptr) return true;
+  if (jacobians[0] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 1, 7>> j(jacobians[0]);
+    j.head<4>() = s * g.transpose() * RotateJacobian(pose_n, p_x_);
+    j.tail<3>() = s * g.transpose();
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 1, 7>> j(jacobians[1]);
+    j.head<4>() = s * c_normal_.transpose() * InverseRotateJacobian(pose_c, w);
+    j.tail<3>() = -s * g.transpose();
+  }
+  return true;
+}
+
+// r = s (v - pi(d)), d = +-R_wn^T d_w (flipped to z >= 0, z clamped at min_z as in the autodiff
+// functor). dr/dd = -s [fx/z 0 -fx x/z^2; 0 fy/z -fy y/z^2] (third column 0 when clamped);
+// dr/dq = dr/dd * sign * d(R^T d_w)/dq; the translation columns are exactly zero.
+bool DirectionProjectionAnalyticCost::Evaluate(double const* const* parameters, double* residuals,
+                                               double** jacobians) const {
+  const double* pose = parameters[0];
+  const Eigen::Map<const Eigen::Quaterniond> q_wc(pose);
+  Eigen::Vector3d d = q_wc.conjugate() * direction_world_;
+  const double sign = d.z() < 0 ? -1.0 : 1.0;
+  d *= sign;
+  const bool clamped = d.z() < min_z_;
+  if (clamped) d.z() = min_z_;
+  const double inv_z = 1.0 / d.z();
+  const double s = sqrt_information_;
+  residuals[0] = s * (vp_.x() - (camera_.fx * d.x() * inv_z + camera_.cx));
+  residuals[1] = s * (vp_.y() - (camera_.fy * d.y() * inv_z + camera_.cy));
+  if (jacobians == nullptr || jacobians[0] == nullptr) return true;
+  Eigen::Matrix<double, 2, 3> dr_dd;
+  dr_dd << -s * camera_.fx * inv_z, 0, s * camera_.fx * d.x() * inv_z * inv_z,  //
+      0, -s * camera_.fy * inv_z, s * camera_.fy * d.y() * inv_z * inv_z;
+  if (clamped) dr_dd.col(2).setZero();
+  Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jacobians[0]);
+  j.leftCols<4>() = sign * dr_dd * InverseRotateJacobian(pose, direction_world_);
+  j.rightCols<3>().setZero();
+  return true;
+}
+
+}  // namespace jvl::optim

@@ -1,0 +1,62 @@
+// Analytic-Jacobian twins of PointToImlsCost and DirectionProjectionCost (supplement 2).
+//
+// Same residuals as the autodiff functors in cost_functions.h; the Jacobians are with respect to
+// the ambient 7-vector [qx qy qz qw tx ty tz] (Ceres multiplies them by the manifold's
+// PlusJacobian). Supplement 2 writes them on the SE(3) tangent of T_cw / T_nw; with our
+// world_from_cam blocks the same chain rule is applied to R(q) v = v + 2w (u x v) + 2 u x (u x v),
+// q = (u, w). They are tested against the autodiff versions and numeric differentiation
+// (analytic_costs_test.cc) and benchmarked in optim_benchmark.cc.
+#pragma once
+
+#include <ceres/sized_cost_function.h>
+
+#include <Eigen/Core>
+
+#include "geometry/camera.h"
+
+namespace jvl::optim {
+
+// d(R(q) v)/d[qx qy qz qw] for the unit quaternion q stored as [x y z w].
+Eigen::Matrix<double, 3, 4> RotateJacobian(const double* q_xyzw, const Eigen::Vector3d& v);
+// d(R(q)^T v)/d[qx qy qz qw].
+Eigen::Matrix<double, 3, 4> InverseRotateJacobian(const double* q_xyzw, const Eigen::Vector3d& v);
+
+class PointToImlsAnalyticCost : public ceres::SizedCostFunction<1, 7, 7> {
+ public:
+  PointToImlsAnalyticCost(const Eigen::Vector3d& p_x, const Eigen::Vector3d& c_p_y,
+                          const Eigen::Vector3d& c_normal, double sqrt_information)
+      : p_x_(p_x), c_p_y_(c_p_y), c_normal_(c_normal), sqrt_information_(sqrt_information) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const Eigen::Vector3d p_x_;
+  const Eigen::Vector3d c_p_y_;
+  const Eigen::Vector3d c_normal_;
+  const double sqrt_information_;
+};
+
+class DirectionProjectionAnalyticCost : public ceres::SizedCostFunction<2, 7> {
+ public:
+  DirectionProjectionAnalyticCost(const PinholeCamera& camera, const Eigen::Vector2d& vp,
+                                  const Eigen::Vector3d& direction_world, double sqrt_information,
+                                  double min_z)
+      : camera_(camera),
+        vp_(vp),
+        direction_world_(direction_world.normalized()),
+        sqrt_information_(sqrt_information),
+        min_z_(min_z) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const PinholeCamera camera_;
+  const Eigen::Vector2d vp_;
+  const Eigen::Vector3d direction_world_;
+  const double sqrt_information_;
+  const double min_z_;
+};
+
+}  // namespace jvl::optim

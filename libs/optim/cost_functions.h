@@ -1,0 +1,150 @@
+// Autodiff Ceres cost functors of the joint energy (Eq. 4 and Eq. 7 of the paper).
+//
+// Pose blocks are world_from_cam [qx qy qz qw tx ty tz] (see pose_block.h); the paper writes
+// T_nw = (world_from_cam_n)^-1, so R_nw = R_wn^T and t_nw = -R_wn^T t_wn.
+// Every functor stores its measurement and square-root information as const members; residuals
+// are "measured minus predicted" as in the paper. Weights (alpha, beta, gamma) and robust kernels
+// are applied at problem building through ceres::ScaledLoss, not here.
+#pragma once
+
+#include <ceres/autodiff_cost_function.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "geometry/camera.h"
+
+namespace jvl::optim {
+
+// Pinhole projection pi of a camera-frame point or direction (Eq. 1), templated for Jets.
+template <typename T>
+void ProjectPinhole(const PinholeCamera& camera, const Eigen::Matrix<T, 3, 1>& p, T* uv) {
+  uv[0] = T(camera.fx) * p.x() / p.z() + T(camera.cx);
+  uv[1] = T(camera.fy) * p.y() / p.z() + T(camera.cy);
+}
+
+// Visual reprojection error e_V(i, j) (Sec. 4.2 step 1, as in ORB-SLAM):
+//   X_c = R_iw X + t_iw = R_wi^T (X - t_wi),   r = sqrt_info * (x - pi(X_c))   [2]
+// sqrt_info = 1 / sigma with sigma = 1.2^octave px (ORB-SLAM's information is 1 / sigma^2).
+// A point at depth <= kMinDepth makes the evaluation fail (Ceres then rejects the step); the
+// problem builder drops observations that are behind the camera at the initial estimate.
+class VisualReprojectionCost {
+ public:
+  static constexpr double kMinDepth = 1e-6;
+
+  VisualReprojectionCost(const PinholeCamera& camera, const Eigen::Vector2d& uv,
+                         double sqrt_information)
+      : camera_(camera), uv_(uv), sqrt_information_(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* world_from_cam, const T* point_world, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wc(world_from_cam);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wc(world_from_cam + 4);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> x_w(point_world);
+    const Eigen::Matrix<T, 3, 1> x_c = q_wc.conjugate() * (x_w - t_wc);
+    if (!(x_c.z() > T(kMinDepth))) return false;
+    T uv[2];
+    ProjectPinhole(camera_, x_c, uv);
+    residual[0] = T(sqrt_information_) * (T(uv_.x()) - uv[0]);
+    residual[1] = T(sqrt_information_) * (T(uv_.y()) - uv[1]);
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
+                                     double sqrt_information) {
+    return new ceres::AutoDiffCostFunction<VisualReprojectionCost, 2, 7, 3>(
+        new VisualReprojectionCost(camera, uv, sqrt_information));
+  }
+
+ private:
+  const PinholeCamera camera_;
+  const Eigen::Vector2d uv_;
+  const double sqrt_information_;
+};
+
+// Point-to-IMLS-surface error e_L(n, j) (Eq. 3; supplement Eq. 1 for reused correspondences):
+//   c_p_x = T_cw T_nw^-1 p_x = R_wc^T (R_wn p_x + t_wn - t_wc)
+//   r = sqrt_info * (c_p_x - c_p_y) . n_c                                         [1]
+// p_x is the sampled point in keyframe n's frame; c_p_y (its projection onto the IMLS surface)
+// and the unit normal n_c are in keyframe c's frame. n != c (the builder rejects n == c: the
+// residual would not depend on the pose at all).
+class PointToImlsCost {
+ public:
+  PointToImlsCost(const Eigen::Vector3d& p_x, const Eigen::Vector3d& c_p_y,
+                  const Eigen::Vector3d& c_normal, double sqrt_information)
+      : p_x_(p_x), c_p_y_(c_p_y), c_normal_(c_normal), sqrt_information_(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* world_from_n, const T* world_from_c, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wn(world_from_n);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wn(world_from_n + 4);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wc(world_from_c);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wc(world_from_c + 4);
+    const Eigen::Matrix<T, 3, 1> p_w = q_wn * p_x_.cast<T>() + t_wn;
+    const Eigen::Matrix<T, 3, 1> c_p_x = q_wc.conjugate() * (p_w - t_wc);
+    residual[0] = T(sqrt_information_) * (c_p_x - c_p_y_.cast<T>()).dot(c_normal_.cast<T>());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& p_x, const Eigen::Vector3d& c_p_y,
+                                     const Eigen::Vector3d& c_normal, double sqrt_information) {
+    return new ceres::AutoDiffCostFunction<PointToImlsCost, 1, 7, 7>(
+        new PointToImlsCost(p_x, c_p_y, c_normal, sqrt_information));
+  }
+
+ private:
+  const Eigen::Vector3d p_x_;
+  const Eigen::Vector3d c_p_y_;
+  const Eigen::Vector3d c_normal_;
+  const double sqrt_information_;
+};
+
+// Direction projection error e_D(n) (Eq. 5-6): the direction prior d_w = [d_w, 0] is a point at
+// infinity, so its image is the vanishing point
+//   d_n = R_nw d_w = R_wn^T d_w,   r = sqrt_info * (v - pi(d_n))                   [2]
+// Only the rotation enters: the derivative with respect to the translation part of the block is
+// exactly zero. Guards (not in the paper):
+//  - a line direction is unoriented and pi(d) = pi(-d), so d_n is flipped to z >= 0;
+//  - if z < min_z (direction nearly parallel to the image plane, the VP runs to infinity) z is
+//    clamped to min_z: the residual stays finite (large) and still pulls the direction back
+//    towards the optical axis through its x/y derivatives.
+class DirectionProjectionCost {
+ public:
+  DirectionProjectionCost(const PinholeCamera& camera, const Eigen::Vector2d& vp,
+                          const Eigen::Vector3d& direction_world, double sqrt_information,
+                          double min_z)
+      : camera_(camera),
+        vp_(vp),
+        direction_world_(direction_world.normalized()),
+        sqrt_information_(sqrt_information),
+        min_z_(min_z) {}
+
+  template <typename T>
+  bool operator()(const T* world_from_cam, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wc(world_from_cam);
+    Eigen::Matrix<T, 3, 1> d_n = q_wc.conjugate() * direction_world_.cast<T>();
+    if (d_n.z() < T(0)) d_n = -d_n;
+    if (d_n.z() < T(min_z_)) d_n.z() = T(min_z_);
+    T uv[2];
+    ProjectPinhole(camera_, d_n, uv);
+    residual[0] = T(sqrt_information_) * (T(vp_.x()) - uv[0]);
+    residual[1] = T(sqrt_information_) * (T(vp_.y()) - uv[1]);
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& vp,
+                                     const Eigen::Vector3d& direction_world,
+                                     double sqrt_information, double min_z) {
+    return new ceres::AutoDiffCostFunction<DirectionProjectionCost, 2, 7>(
+        new DirectionProjectionCost(camera, vp, direction_world, sqrt_information, min_z));
+  }
+
+ private:
+  const PinholeCamera camera_;
+  const Eigen::Vector2d vp_;
+  const Eigen::Vector3d direction_world_;
+  const double sqrt_information_;
+  const double min_z_;
+};
+
+}  // namespace jvl::optim

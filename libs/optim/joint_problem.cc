@@ -1,0 +1,200 @@
+#include "optim/joint_problem.h"
+
+#include <ceres/loss_function.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+#include "optim/analytic_costs.h"
+#include "optim/cost_functions.h"
+
+namespace jvl::optim {
+namespace {
+
+bool Finite(const Eigen::Vector3d& v) { return v.allFinite(); }
+
+// Weight and Huber kernel of one residual type; ScaledLoss(nullptr, w) is a plain weight.
+ceres::LossFunction* MakeLoss(double weight, double huber) {
+  ceres::LossFunction* robust = huber > 0 ? new ceres::HuberLoss(huber) : nullptr;
+  return new ceres::ScaledLoss(robust, weight, ceres::TAKE_OWNERSHIP);
+}
+
+void CheckKeyframe(const JointProblemInput& input, int64_t id, const char* what) {
+  JVL_CHECK(input.poses.count(id), what << " refers to keyframe " << id << " which has no pose");
+}
+
+// All validation happens before anything is added to the problem (no half-built state).
+void CheckResiduals(const JointProblemInput& input) {
+  for (const VisualObservation& obs : input.observations) {
+    CheckKeyframe(input, obs.keyframe, "visual observation");
+    JVL_CHECK(obs.map_point >= 0 && static_cast<size_t>(obs.map_point) < input.map_points.size(),
+              "observation in keyframe " << obs.keyframe << " refers to map point " << obs.map_point
+                                         << " of " << input.map_points.size());
+    JVL_CHECK(obs.uv.allFinite() && obs.octave >= 0,
+              "observation of map point " << obs.map_point << " in keyframe " << obs.keyframe
+                                          << " has a non-finite pixel or negative octave");
+  }
+  for (const ImlsCorrespondence& l : input.imls) {
+    CheckKeyframe(input, l.n, "IMLS correspondence");
+    CheckKeyframe(input, l.c, "IMLS correspondence");
+    JVL_CHECK(l.n != l.c,
+              "IMLS correspondence with n == c == " << l.n << " (must join two keyframes)");
+    JVL_CHECK(Finite(l.p_x) && Finite(l.c_p_y) && Finite(l.c_normal) &&
+                  std::abs(l.c_normal.norm() - 1.0) < 1e-3,
+              "IMLS correspondence (" << l.n << ", " << l.c
+                                      << ") has non-finite points or a non-unit normal");
+  }
+  for (const DirectionConstraint& d : input.directions) {
+    CheckKeyframe(input, d.keyframe, "direction constraint");
+    JVL_CHECK(d.vp.allFinite() && Finite(d.direction_world) && d.direction_world.norm() > 1e-9,
+              "direction constraint of keyframe " << d.keyframe
+                                                  << " has a non-finite VP or a zero direction");
+  }
+}
+
+void CheckInput(const JointProblemInput& input) {
+  input.camera.Check();
+  JVL_CHECK(!input.poses.empty(), "joint problem has no keyframe poses");
+  for (const auto& [id, pose] : input.poses) {
+    JVL_CHECK(pose.translation().allFinite() && pose.rotation().coeffs().allFinite(),
+              "pose of keyframe " << id << " is not finite");
+  }
+  for (int64_t id : input.fixed) {
+    JVL_CHECK(input.poses.count(id), "fixed keyframe " << id << " has no pose");
+  }
+  for (size_t i = 0; i < input.map_points.size(); ++i) {
+    JVL_CHECK(Finite(input.map_points[i]), "map point " << i << " is not finite");
+  }
+  CheckResiduals(input);
+}
+
+void AddVisual(const JointProblemInput& input, const JointProblemOptions& options,
+               ceres::LossFunction* loss, JointProblem& jp) {
+  std::vector<bool> used(input.map_points.size(), false);
+  for (const VisualObservation& obs : input.observations) {
+    double* pose = jp.poses.at(obs.keyframe).data();
+    double* point = jp.map_points[obs.map_point].data();
+    // Drop what is behind the camera now: the functor could not be evaluated (ORB-SLAM removes
+    // such observations before BA as well).
+    const Eigen::Vector3d x_c =
+        input.poses.at(obs.keyframe).Inverse() * input.map_points[obs.map_point];
+    if (!(x_c.z() > VisualReprojectionCost::kMinDepth)) {
+      ++jp.dropped_observations;
+      continue;
+    }
+    const double sigma = std::pow(options.octave_scale_factor, obs.octave);
+    jp.visual_blocks.push_back(jp.problem->AddResidualBlock(
+        VisualReprojectionCost::Create(input.camera, obs.uv, 1.0 / sigma), loss, pose, point));
+    used[obs.map_point] = true;
+  }
+  for (size_t i = 0; i < used.size(); ++i) {
+    if (!used[i]) continue;
+    if (options.optimize_map_points) {
+      jp.has_free_map_points = true;
+    } else {
+      jp.problem->SetParameterBlockConstant(jp.map_points[i].data());
+    }
+  }
+}
+
+void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
+             ceres::LossFunction* loss, JointProblem& jp) {
+  const double sqrt_info = 1.0 / options.imls_sigma_m;
+  for (const ImlsCorrespondence& l : input.imls) {
+    double* pose_n = jp.poses.at(l.n).data();
+    double* pose_c = jp.poses.at(l.c).data();
+    ceres::CostFunction* cost =
+        options.analytic_jacobians ? static_cast<ceres::CostFunction*>(new PointToImlsAnalyticCost(
+                                         l.p_x, l.c_p_y, l.c_normal, sqrt_info))
+                                   : PointToImlsCost::Create(l.p_x, l.c_p_y, l.c_normal, sqrt_info);
+    jp.imls_blocks.push_back(jp.problem->AddResidualBlock(cost, loss, pose_n, pose_c));
+  }
+}
+
+void AddDirections(const JointProblemInput& input, const JointProblemOptions& options,
+                   ceres::LossFunction* loss, JointProblem& jp) {
+  const double sqrt_info = 1.0 / options.direction_sigma_px;
+  for (const DirectionConstraint& d : input.directions) {
+    double* pose = jp.poses.at(d.keyframe).data();
+    const double min_z = options.direction_min_z;
+    ceres::CostFunction* cost =
+        options.analytic_jacobians
+            ? static_cast<ceres::CostFunction*>(new DirectionProjectionAnalyticCost(
+                  input.camera, d.vp, d.direction_world, sqrt_info, min_z))
+            : DirectionProjectionCost::Create(input.camera, d.vp, d.direction_world, sqrt_info,
+                                              min_z);
+    jp.direction_blocks.push_back(jp.problem->AddResidualBlock(cost, loss, pose));
+  }
+}
+
+}  // namespace
+
+void JointProblemOptions::Check() const {
+  JVL_CHECK(std::isfinite(alpha) && alpha > 0, "alpha must be positive (got " << alpha << ")");
+  JVL_CHECK(std::isfinite(beta) && std::isfinite(gamma), "beta and gamma must be finite");
+  JVL_CHECK(beta_scale > 0 && gamma_scale > 0, "beta_scale and gamma_scale must be positive");
+  JVL_CHECK(octave_scale_factor >= 1, "octave_scale_factor must be >= 1");
+  JVL_CHECK(imls_sigma_m > 0 && direction_sigma_px > 0, "residual sigmas must be positive");
+  JVL_CHECK(direction_min_z > 0 && direction_min_z < 1, "direction_min_z must be in (0, 1)");
+  JVL_CHECK(
+      std::isfinite(visual_huber) && std::isfinite(imls_huber) && std::isfinite(direction_huber),
+      "Huber thresholds must be finite");
+}
+
+JointWeights ResolveWeights(const JointProblemOptions& options, int64_t num_visual,
+                            int64_t num_imls, int64_t num_directions) {
+  const double n_ref = static_cast<double>(
+      num_visual > 0 ? num_visual : std::max<int64_t>({num_imls, num_directions, 1}));
+  JointWeights w;
+  w.alpha = options.alpha;
+  w.beta = options.beta > 0 ? options.beta
+           : num_imls > 0   ? options.alpha * options.beta_scale * n_ref / num_imls
+                            : options.alpha * options.beta_scale;
+  w.gamma = options.gamma > 0    ? options.gamma
+            : num_directions > 0 ? options.alpha * options.gamma_scale * n_ref / num_directions
+                                 : options.alpha * options.gamma_scale;
+  return w;
+}
+
+JointProblem BuildJointProblem(const JointProblemInput& input, const JointProblemOptions& options) {
+  options.Check();
+  CheckInput(input);
+  JointProblem jp;
+  for (const auto& [id, pose] : input.poses) jp.poses[id] = ToPoseBlock(pose);
+  jp.map_points.reserve(input.map_points.size());  // addresses must stay stable
+  for (const Eigen::Vector3d& p : input.map_points) jp.map_points.push_back({p.x(), p.y(), p.z()});
+
+  ceres::Problem::Options problem_options;
+  problem_options.enable_fast_removal = false;
+  jp.problem = std::make_unique<ceres::Problem>(problem_options);
+  // One shared manifold; Ceres deletes each distinct pointer once.
+  ceres::Manifold* manifold = MakePoseManifold().release();
+  for (auto& [id, block] : jp.poses) {
+    jp.problem->AddParameterBlock(block.data(), kPoseBlockSize, manifold);
+  }
+  // Counts for the weight rule are taken from the inputs (before dropping invalid observations).
+  jp.weights = ResolveWeights(options, static_cast<int64_t>(input.observations.size()),
+                              static_cast<int64_t>(input.imls.size()),
+                              static_cast<int64_t>(input.directions.size()));
+  // The problem owns a loss only once a residual uses it; unused ones are freed here.
+  std::unique_ptr<ceres::LossFunction> visual_loss(
+      MakeLoss(jp.weights.alpha, options.visual_huber));
+  std::unique_ptr<ceres::LossFunction> imls_loss(MakeLoss(jp.weights.beta, options.imls_huber));
+  std::unique_ptr<ceres::LossFunction> direction_loss(
+      MakeLoss(jp.weights.gamma, options.direction_huber));
+  AddVisual(input, options, visual_loss.get(), jp);
+  AddImls(input, options, imls_loss.get(), jp);
+  AddDirections(input, options, direction_loss.get(), jp);
+  if (!jp.visual_blocks.empty()) visual_loss.release();
+  if (!jp.imls_blocks.empty()) imls_loss.release();
+  if (!jp.direction_blocks.empty()) direction_loss.release();
+
+  // Gauge: the fixed keyframes, or the first one (six degrees of freedom; LiDAR fixes scale).
+  jp.fixed = input.fixed;
+  if (jp.fixed.empty()) jp.fixed.insert(jp.poses.begin()->first);
+  for (int64_t id : jp.fixed) jp.problem->SetParameterBlockConstant(jp.poses.at(id).data());
+  return jp;
+}
+
+}  // namespace jvl::optim

@@ -1,0 +1,151 @@
+// Joint visual + point-to-IMLS + direction problem (Eq. 4 local energy, Eq. 7 global energy).
+//
+//   E = alpha sum rho_V(|e_V|^2) + beta sum rho_L(e_L^2) + gamma sum rho_D(|e_D|^2)
+//
+// BuildJointProblem() turns plain inputs into a ceres::Problem (poses as world_from_cam blocks on
+// the pose manifold, map points as 3-blocks, gauge fixed explicitly); SolveJointProblem() runs
+// Levenberg-Marquardt and reports cost per residual type before/after. local_map (Sec. 4.2) and
+// global_opt (Sec. 4.3) both fill JointProblemInput; see docs/optimization.md.
+#pragma once
+
+#include <ceres/problem.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "geometry/rigid3.h"
+#include "optim/pose_block.h"
+
+namespace jvl::optim {
+
+// One keypoint observation x^j of map point X^j in keyframe i (Sec. 4.2 step 1).
+struct VisualObservation {
+  int64_t keyframe = 0;   // key into JointProblemInput::poses
+  int32_t map_point = 0;  // row in JointProblemInput::map_points
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  int octave = 0;  // ORB pyramid level: sigma = scale_factor^octave px
+};
+
+// One saved IMLS correspondence (n, c, p_x, c_p_y, n_c) of the set L (Eq. 3, supplement Eq. 1).
+struct ImlsCorrespondence {
+  int64_t n = 0;  // keyframe owning the sampled point p_x (p_x in n's frame)
+  int64_t c = 0;  // keyframe owning the nearest model point (c_p_y, c_normal in c's frame)
+  Eigen::Vector3d p_x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d c_p_y = Eigen::Vector3d::Zero();
+  Eigen::Vector3d c_normal = Eigen::Vector3d::UnitZ();  // unit
+};
+
+// A vanishing point v of keyframe `keyframe` associated with a world direction prior d_w (Eq. 6).
+struct DirectionConstraint {
+  int64_t keyframe = 0;
+  Eigen::Vector2d vp = Eigen::Vector2d::Zero();  // pixels, finite
+  Eigen::Vector3d direction_world = Eigen::Vector3d::UnitZ();
+};
+
+struct JointProblemInput {
+  PinholeCamera camera;
+  std::map<int64_t, Rigid3d> poses;         // keyframe id -> world_from_cam (initial values)
+  std::set<int64_t> fixed;                  // keyframes held constant; empty: the first id is fixed
+  std::vector<Eigen::Vector3d> map_points;  // world frame
+  std::vector<VisualObservation> observations;
+  std::vector<ImlsCorrespondence> imls;
+  std::vector<DirectionConstraint> directions;
+};
+
+struct JointProblemOptions {
+  // Weights of Eq. (4)/(7). A weight <= 0 means "from the residual counts" (the paper: alpha = 1,
+  // the others set according to the number of residuals). With N_ref = N_V if there are visual
+  // residuals, else max(N_L, N_D):
+  //   beta = alpha * beta_scale * N_ref / N_L,   gamma = alpha * gamma_scale * N_ref / N_D,
+  // i.e. every residual type gets the same total weight as the visual term (times its scale).
+  // A type without residuals gets alpha * scale (irrelevant).
+  double alpha = 1.0;
+  double beta = 0.0;
+  double gamma = 0.0;
+  double beta_scale = 1.0;
+  double gamma_scale = 1.0;
+  // Noise models (square-root information = 1 / sigma).
+  double octave_scale_factor = 1.2;  // ORB-SLAM: sigma_V = 1.2^octave px
+  double imls_sigma_m = 0.05;        // e_L in metres
+  double direction_sigma_px = 1.0;   // e_D in pixels
+  // Huber thresholds on the whitened residual norm; <= 0 disables. ORB-SLAM mono: sqrt(5.991).
+  double visual_huber = 2.447651936039926;
+  double imls_huber = 0.0;
+  double direction_huber = 0.0;
+  double direction_min_z = 0.05;  // clamp of DirectionProjectionCost (see cost_functions.h)
+  bool optimize_map_points = true;
+  bool analytic_jacobians = true;  // analytic e_L / e_D twins (faster, see docs/optimization.md)
+  void Check() const;
+};
+
+struct JointWeights {
+  double alpha = 1.0, beta = 1.0, gamma = 1.0;
+};
+
+// Weights for the given residual counts following the rule documented on JointProblemOptions.
+JointWeights ResolveWeights(const JointProblemOptions& options, int64_t num_visual,
+                            int64_t num_imls, int64_t num_directions);
+
+// The built problem: owns parameter storage (stable addresses) and the ceres::Problem.
+struct JointProblem {
+  std::map<int64_t, PoseBlock> poses;
+  std::vector<std::array<double, 3>> map_points;
+  std::unique_ptr<ceres::Problem> problem;
+  std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks;
+  std::set<int64_t> fixed;  // effective constant poses (gauge)
+  JointWeights weights;
+  int64_t dropped_observations = 0;  // behind the camera at the initial estimate
+  bool has_free_map_points = false;
+};
+
+JointProblem BuildJointProblem(const JointProblemInput& input, const JointProblemOptions& options);
+
+struct SolveOptions {
+  int max_iterations = 100;
+  int threads = 1;
+  double function_tolerance = 1e-6;
+  double gradient_tolerance = 1e-10;
+  double parameter_tolerance = 1e-8;
+  double max_time_s = 1e9;
+  bool log_progress = false;  // Ceres' per-iteration log on stderr
+  void Check() const;
+};
+
+// Cost per residual type: `cost` is what Ceres minimises (0.5 * weight * rho(|r|^2) summed),
+// `rms` the root mean square of the whitened, unweighted, non-robust residual norms.
+struct ResidualStats {
+  int64_t count = 0;
+  double cost = 0.0;
+  double rms = 0.0;
+};
+
+struct JointCostBreakdown {
+  ResidualStats visual, imls, direction;
+  double total = 0.0;
+};
+
+struct JointSolveResult {
+  JointCostBreakdown before, after;
+  JointWeights weights;
+  int iterations = 0;
+  double time_s = 0.0;
+  bool usable = false;      // Ceres returned CONVERGENCE or NO_CONVERGENCE (not FAILURE)
+  std::string termination;  // Ceres' summary line
+  std::string linear_solver;
+  std::map<int64_t, Rigid3d> poses;         // optimised world_from_cam
+  std::vector<Eigen::Vector3d> map_points;  // optimised (unchanged if not optimised)
+};
+
+JointCostBreakdown EvaluateJointCost(JointProblem& problem, int threads);
+JointSolveResult SolveJointProblem(JointProblem& problem, const SolveOptions& options);
+// Build + solve.
+JointSolveResult OptimizeJoint(const JointProblemInput& input, const JointProblemOptions& options,
+                               const SolveOptions& solve_options);
+
+}  // namespace jvl::optim
