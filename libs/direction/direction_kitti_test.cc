@@ -14,6 +14,7 @@
 #include "io/files.h"
 #include "io/kitti.h"
 #include "io/trajectory_io.h"
+#include "io/vps_io.h"
 
 namespace jvl::direction {
 namespace {
@@ -82,36 +83,22 @@ TEST_F(Kitti04, VIntervalReducesAssociations) {
 TEST_F(Kitti04, WritesAVpsArtifactForTheTool) {
   const std::string dir = std::string(JVL_BINARY_DIR) + "/direction_demo";
   io::CreateDirectories(dir);
-  std::vector<int64_t> frame;
-  std::vector<int32_t> index, inliers;
-  std::vector<double> uv, direction, residual, score;
-  std::vector<uint8_t> forward;
+  io::VpsData data;
+  data.frames = gt_.frames;
+  data.camera = camera_;
   for (const auto& vp : vps_) {
-    frame.push_back(vp.frame);
-    index.push_back(vp.vp_index);
-    uv.insert(uv.end(), {vp.uv.x(), vp.uv.y()});
-    direction.insert(direction.end(), vp.direction_cam.data(), vp.direction_cam.data() + 3);
-    inliers.push_back(0);
-    residual.push_back(0);
-    score.push_back(vp.score);
-    forward.push_back(vp.score == 1.0);  // The simulator gives the road VP score 1.
+    io::VpRecord r;
+    r.frame = vp.frame;
+    r.index = vp.vp_index;
+    r.uv = vp.uv;
+    r.direction = vp.direction_cam;
+    r.score = vp.score;
+    r.is_forward = vp.score == 1.0;  // The simulator gives the road VP score 1.
+    data.vps.push_back(r);
   }
-  const int64_t m = int64_t(vps_.size());
-  io::H5Writer w(dir + "/kitti04_vps.h5", "vps", 1);
-  w.WriteArray("frames", gt_.frames);
-  w.WriteArray<double>("camera", {camera_.fx, camera_.fy, camera_.cx, camera_.cy,
-                                  double(camera_.width), double(camera_.height)});
-  w.WriteArray("vps/frame", frame);
-  w.WriteArray("vps/index", index);
-  w.WriteArray("vps/uv", uv, {m, 2});
-  w.WriteArray("vps/direction", direction, {m, 3});
-  w.WriteArray("vps/inliers", inliers);
-  w.WriteArray("vps/residual_deg", residual);
-  w.WriteArray("vps/score", score);
-  w.WriteArray("vps/is_forward", forward);
   io::Provenance p;
   p.tool = "direction_kitti_test";
-  w.Commit(p);
+  io::WriteVpsArtifact(dir + "/kitti04_vps.h5", data, p);
   EXPECT_EQ(io::ReadVpsArtifact(dir + "/kitti04_vps.h5").vps.size(), vps_.size());
 }
 

@@ -19,45 +19,6 @@ void CheckRows(const std::string& path, const std::string& name, const std::vect
 
 }  // namespace
 
-VpsData ReadVpsArtifact(const std::string& path) {
-  const H5Reader r(path, "vps", 1);
-  VpsData data;
-  if (r.Has("frames")) data.frames = r.ReadArray<int64_t>("frames");
-  if (r.Has("camera")) {
-    const auto c = r.ReadArray<double>("camera");
-    JVL_CHECK(c.size() == 6, path << ": camera must hold 6 numbers (fx fy cx cy width height)");
-    PinholeCamera cam;
-    cam.fx = c[0], cam.fy = c[1], cam.cx = c[2], cam.cy = c[3];
-    cam.width = int(c[4]), cam.height = int(c[5]);
-    data.camera = cam;
-  }
-  const auto frame = r.ReadArray<int64_t>("vps/frame");
-  const size_t m = frame.size();
-  const auto index = r.ReadArray<int32_t>("vps/index");
-  const auto uv = r.ReadArray<double>("vps/uv", 2);
-  const auto dir = r.ReadArray<double>("vps/direction", 3);
-  CheckRows(path, "vps/index", index, m, 1);
-  CheckRows(path, "vps/uv", uv, m, 2);
-  CheckRows(path, "vps/direction", dir, m, 3);
-  std::vector<uint8_t> fwd(m, 0);
-  std::vector<double> score(m, 0.0);
-  if (r.Has("vps/is_forward")) fwd = r.ReadArray<uint8_t>("vps/is_forward");
-  if (r.Has("vps/score")) score = r.ReadArray<double>("vps/score");
-  CheckRows(path, "vps/is_forward", fwd, m, 1);
-  CheckRows(path, "vps/score", score, m, 1);
-  data.vps.resize(m);
-  for (size_t i = 0; i < m; ++i) {
-    VpRow& v = data.vps[i];
-    v.frame = frame[i];
-    v.index = index[i];
-    v.uv = {uv[2 * i], uv[2 * i + 1]};
-    v.direction = {dir[3 * i], dir[3 * i + 1], dir[3 * i + 2]};
-    v.is_forward = fwd[i] != 0;
-    v.score = score[i];
-  }
-  return data;
-}
-
 void WriteDirectionsArtifact(const std::string& path, const DirectionsData& data,
                              const Provenance& provenance) {
   H5Writer w(path, "directions", 1);

@@ -1,6 +1,5 @@
 // The "directions" artifact (schema "directions" v1, schemas/directions.schema.json): direction
-// priors d_w (clusters) and the VPs associated to them (at most one per frame); its CSV export;
-// and a minimal reader of the "vps" artifact (schema "vps" v1) for direction_cluster.
+// priors d_w (clusters) and the VPs associated to them (at most one per frame); its CSV export.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,25 +13,6 @@
 #include "io/artifact.h"
 
 namespace jvl::io {
-
-struct VpRow {
-  int64_t frame = 0;
-  int32_t index = 0;
-  Eigen::Vector2d uv = Eigen::Vector2d::Zero();         // NaN if at infinity.
-  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // Unit, camera frame, z >= 0.
-  bool is_forward = false;
-  double score = 0;
-};
-
-struct VpsData {
-  std::vector<int64_t> frames;          // All processed frames.
-  std::optional<PinholeCamera> camera;  // From "camera" (fx fy cx cy width height) if present.
-  std::vector<VpRow> vps;
-};
-
-// Reads frames, camera and vps/{frame,index,uv,direction,is_forward,score} of a vps artifact.
-// Throws naming the file on a wrong schema or inconsistent row counts.
-VpsData ReadVpsArtifact(const std::string& path);
 
 struct DirectionClusterRow {
   int32_t id = 0;

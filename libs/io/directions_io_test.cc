@@ -1,4 +1,5 @@
 #include "io/directions_io.h"
+#include "io/vps_io.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -95,8 +96,7 @@ TEST_F(DirectionsIoTest, ReadsTheAgreedVpsLayout) {
     w.Commit(Provenance{});
   }
   const VpsData v = ReadVpsArtifact(Path("vps.h5"));
-  ASSERT_TRUE(v.camera);
-  EXPECT_EQ(v.camera->width, 1226);
+  EXPECT_EQ(v.camera.width, 1226);
   ASSERT_EQ(v.vps.size(), 3u);
   EXPECT_EQ(v.vps[2].index, 1);
   EXPECT_EQ(v.vps[2].direction, Eigen::Vector3d(1, 0, 0));

@@ -12,6 +12,7 @@
 #include "io/directions_io.h"
 #include "io/kitti.h"
 #include "io/trajectory_io.h"
+#include "io/vps_io.h"
 
 namespace {
 
@@ -121,8 +122,8 @@ int main(int argc, char** argv) {
     const Trajectory prior = io::ReadTrajectory(prior_path);
     tool.AddInput(prior_path);
     PinholeCamera camera;
-    if (vps.camera) {
-      camera = *vps.camera;
+    if (vps.camera.fx > 0) {
+      camera = vps.camera;
     } else {
       JVL_CHECK(!dataset.empty(), vps_path << " has no camera; pass --dataset for the intrinsics");
       const auto ds = io::OpenDataset(dataset);
