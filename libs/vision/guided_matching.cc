@@ -1,0 +1,216 @@
+#include "vision/guided_matching.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/check.h"
+
+namespace jvl::vision {
+namespace {
+
+// Resolves keypoints claimed by several queries: the one with the smallest distance keeps it.
+void ResolveConflicts(std::vector<int>* match, const std::vector<int>& distance, size_t n_keypoints) {
+  std::vector<int> owner(n_keypoints, -1);
+  for (size_t i = 0; i < match->size(); ++i) {
+    const int k = (*match)[i];
+    if (k < 0) continue;
+    const int o = owner[k];
+    if (o < 0 || distance[i] < distance[o]) {
+      if (o >= 0) (*match)[o] = -1;
+      owner[k] = static_cast<int>(i);
+    } else {
+      (*match)[i] = -1;
+    }
+  }
+}
+
+void ApplyRotationCheck(std::vector<int>* match, const std::vector<float>& angle_diff) {
+  std::vector<int> rows;
+  std::vector<float> diffs;
+  for (size_t i = 0; i < match->size(); ++i) {
+    if ((*match)[i] < 0) continue;
+    rows.push_back(static_cast<int>(i));
+    diffs.push_back(angle_diff[i]);
+  }
+  const std::vector<bool> keep = RotationConsistent(diffs);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    if (!keep[r]) (*match)[rows[r]] = -1;
+  }
+}
+
+}  // namespace
+
+KeypointGrid::KeypointGrid(const std::vector<OrbKeypoint>& keypoints, int width, int height,
+                           int cell)
+    : keypoints_(&keypoints),
+      cell_(cell),
+      nx_(std::max(1, (width + cell - 1) / cell)),
+      ny_(std::max(1, (height + cell - 1) / cell)),
+      cells_(static_cast<size_t>(nx_) * ny_) {
+  for (size_t i = 0; i < keypoints.size(); ++i) {
+    const int cx = std::clamp(static_cast<int>(keypoints[i].uv.x()) / cell_, 0, nx_ - 1);
+    const int cy = std::clamp(static_cast<int>(keypoints[i].uv.y()) / cell_, 0, ny_ - 1);
+    cells_[static_cast<size_t>(cy) * nx_ + cx].push_back(static_cast<int>(i));
+  }
+}
+
+std::vector<int> KeypointGrid::InWindow(const Eigen::Vector2d& uv, double radius, int min_octave,
+                                        int max_octave) const {
+  std::vector<int> out;
+  const int x0 = std::max(0, static_cast<int>(std::floor((uv.x() - radius) / cell_)));
+  const int x1 = std::min(nx_ - 1, static_cast<int>(std::floor((uv.x() + radius) / cell_)));
+  const int y0 = std::max(0, static_cast<int>(std::floor((uv.y() - radius) / cell_)));
+  const int y1 = std::min(ny_ - 1, static_cast<int>(std::floor((uv.y() + radius) / cell_)));
+  for (int cy = y0; cy <= y1; ++cy) {
+    for (int cx = x0; cx <= x1; ++cx) {
+      for (int i : cells_[static_cast<size_t>(cy) * nx_ + cx]) {
+        const OrbKeypoint& k = (*keypoints_)[i];
+        if (k.octave < min_octave || k.octave > max_octave) continue;
+        if (std::abs(k.uv.x() - uv.x()) > radius || std::abs(k.uv.y() - uv.y()) > radius) continue;
+        out.push_back(i);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<bool> RotationConsistent(const std::vector<float>& angle_diff_deg, int bins) {
+  std::vector<int> bin(angle_diff_deg.size());
+  std::vector<int> count(bins, 0);
+  for (size_t i = 0; i < angle_diff_deg.size(); ++i) {
+    double d = std::fmod(static_cast<double>(angle_diff_deg[i]), 360.0);
+    if (d < 0) d += 360.0;
+    bin[i] = std::min(bins - 1, static_cast<int>(d * bins / 360.0));
+    ++count[bin[i]];
+  }
+  // Three largest bins; a bin far below the largest (< 10 %) does not count (ORB-SLAM2).
+  std::vector<int> order(bins);
+  for (int b = 0; b < bins; ++b) order[b] = b;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return count[a] > count[b]; });
+  std::vector<bool> good_bin(bins, false);
+  for (int r = 0; r < std::min(3, bins); ++r) {
+    if (count[order[r]] > 0 && (r == 0 || count[order[r]] >= 0.1 * count[order[0]])) {
+      good_bin[order[r]] = true;
+    }
+  }
+  std::vector<bool> keep(angle_diff_deg.size());
+  for (size_t i = 0; i < keep.size(); ++i) keep[i] = good_bin[bin[i]];
+  return keep;
+}
+
+void ProjectionMatchOptions::Check() const {
+  JVL_CHECK(window_px > 0, "matching: window_px must be > 0");
+  JVL_CHECK(max_distance > 0 && max_distance <= 256, "matching: max_distance in (0, 256]");
+  JVL_CHECK(ratio > 0 && ratio <= 1, "matching: ratio must be in (0, 1]");
+}
+
+void EpipolarMatchOptions::Check() const {
+  JVL_CHECK(max_distance > 0 && max_distance <= 256, "matching: max_distance in (0, 256]");
+  JVL_CHECK(ratio > 0 && ratio <= 1, "matching: ratio must be in (0, 1]");
+  JVL_CHECK(epipolar_chi2 > 0, "matching: epipolar_chi2 must be > 0");
+  JVL_CHECK(min_epipole_px >= 0, "matching: min_epipole_px must be >= 0");
+}
+
+std::vector<int> MatchByProjection(const std::vector<ProjectedPoint>& points,
+                                   const OrbFeatures& frame, const KeypointGrid& grid,
+                                   const std::vector<double>& level_scales,
+                                   const ProjectionMatchOptions& options,
+                                   const std::vector<bool>& taken) {
+  const int max_level = static_cast<int>(level_scales.size()) - 1;
+  std::vector<int> match(points.size(), -1), dist(points.size(), 256);
+  std::vector<float> angle_diff(points.size(), 0.f);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const ProjectedPoint& p = points[i];
+    const int level = std::clamp(p.predicted_octave, 0, max_level);
+    const double radius = options.window_px * level_scales[level];
+    int best = 256, second = 256, best_level = -1, second_level = -1, best_k = -1;
+    for (int k : grid.InWindow(p.uv, radius, level - 1, level)) {
+      if (!taken.empty() && taken[k]) continue;
+      const int d = HammingDistance(p.descriptor, frame.descriptors[k]);
+      if (d < best) {
+        second = best, second_level = best_level;
+        best = d, best_level = frame.keypoints[k].octave, best_k = k;
+      } else if (d < second) {
+        second = d, second_level = frame.keypoints[k].octave;
+      }
+    }
+    if (best_k < 0 || best > options.max_distance) continue;
+    if (best_level == second_level && best > options.ratio * second) continue;
+    match[i] = best_k;
+    dist[i] = best;
+    angle_diff[i] = frame.keypoints[best_k].angle - p.reference_angle;
+  }
+  ResolveConflicts(&match, dist, frame.size());
+  if (options.check_orientation) ApplyRotationCheck(&match, angle_diff);
+  return match;
+}
+
+Eigen::Matrix3d FundamentalFromPoses(const PinholeCamera& camera, const Rigid3d& cam1_from_world,
+                                     const Rigid3d& cam2_from_world) {
+  const Rigid3d cam2_from_cam1 = cam2_from_world * cam1_from_world.Inverse();
+  const Eigen::Matrix3d e = Skew(cam2_from_cam1.translation()) * cam2_from_cam1.RotationMatrix();
+  const Eigen::Matrix3d k_inv = camera.K().inverse();
+  return k_inv.transpose() * e * k_inv;
+}
+
+std::vector<std::pair<int, int>> MatchEpipolar(const PinholeCamera& camera, const OrbFeatures& f1,
+                                               const Rigid3d& cam1_from_world,
+                                               const std::vector<bool>& used1,
+                                               const OrbFeatures& f2,
+                                               const Rigid3d& cam2_from_world,
+                                               const std::vector<bool>& used2,
+                                               const std::vector<double>& level_scales,
+                                               const EpipolarMatchOptions& options) {
+  const Eigen::Matrix3d f21 = FundamentalFromPoses(camera, cam1_from_world, cam2_from_world);
+  // Epipole in view 2: the centre of camera 1 projected.
+  const Eigen::Vector3d c1_in_2 = cam2_from_world * cam1_from_world.Inverse().translation();
+  const bool has_epipole = c1_in_2.z() > 1e-9;
+  const Eigen::Vector2d epipole = has_epipole ? camera.Project(c1_in_2) : Eigen::Vector2d::Zero();
+  std::vector<int> candidates2;
+  for (size_t j = 0; j < f2.size(); ++j) {
+    if (!used2.empty() && used2[j]) continue;
+    const OrbKeypoint& k = f2.keypoints[j];
+    const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
+    if (has_epipole && (k.uv.cast<double>() - epipole).squaredNorm() <
+                           options.min_epipole_px * options.min_epipole_px * s) {
+      continue;
+    }
+    candidates2.push_back(static_cast<int>(j));
+  }
+  std::vector<int> match(f1.size(), -1), dist(f1.size(), 256);
+  std::vector<float> angle_diff(f1.size(), 0.f);
+  for (size_t i = 0; i < f1.size(); ++i) {
+    if (!used1.empty() && used1[i]) continue;
+    const Eigen::Vector3d line = f21 * f1.keypoints[i].uv.cast<double>().homogeneous();
+    const double inv_norm2 = 1.0 / std::max(1e-30, line.head<2>().squaredNorm());
+    int best = 256, second = 256, best_j = -1;
+    for (int j : candidates2) {
+      const OrbKeypoint& k = f2.keypoints[j];
+      const double r = line.x() * k.uv.x() + line.y() * k.uv.y() + line.z();
+      const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
+      if (r * r * inv_norm2 >= options.epipolar_chi2 * s * s) continue;
+      const int d = HammingDistance(f1.descriptors[i], f2.descriptors[j]);
+      if (d < best) {
+        second = best;
+        best = d, best_j = j;
+      } else if (d < second) {
+        second = d;
+      }
+    }
+    if (best_j < 0 || best > options.max_distance || best > options.ratio * second) continue;
+    match[i] = best_j;
+    dist[i] = best;
+    angle_diff[i] = f2.keypoints[best_j].angle - f1.keypoints[i].angle;
+  }
+  ResolveConflicts(&match, dist, f2.size());
+  if (options.check_orientation) ApplyRotationCheck(&match, angle_diff);
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t i = 0; i < match.size(); ++i) {
+    if (match[i] >= 0) pairs.emplace_back(static_cast<int>(i), match[i]);
+  }
+  return pairs;
+}
+
+}  // namespace jvl::vision
