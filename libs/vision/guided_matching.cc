@@ -111,6 +111,7 @@ void EpipolarMatchOptions::Check() const {
   JVL_CHECK(ratio > 0 && ratio <= 1, "matching: ratio must be in (0, 1]");
   JVL_CHECK(epipolar_chi2 > 0, "matching: epipolar_chi2 must be > 0");
   JVL_CHECK(min_epipole_px >= 0, "matching: min_epipole_px must be >= 0");
+  JVL_CHECK(max_octave_difference >= 0, "matching: max_octave_difference must be >= 0");
 }
 
 std::vector<int> MatchByProjection(const std::vector<ProjectedPoint>& points,
@@ -188,6 +189,7 @@ std::vector<std::pair<int, int>> MatchEpipolar(const PinholeCamera& camera, cons
     int best = 256, second = 256, best_j = -1;
     for (int j : candidates2) {
       const OrbKeypoint& k = f2.keypoints[j];
+      if (std::abs(k.octave - f1.keypoints[i].octave) > options.max_octave_difference) continue;
       const double r = line.x() * k.uv.x() + line.y() * k.uv.y() + line.z();
       const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
       if (r * r * inv_norm2 >= options.epipolar_chi2 * s * s) continue;

@@ -65,6 +65,7 @@ struct EpipolarMatchOptions {
   double ratio = 0.8;             // Best/second-best ratio among candidates on the line.
   double epipolar_chi2 = 3.84;    // chi2(1 dof, 95%) times the level variance.
   double min_epipole_px = 10.0;   // Keypoints this close to the epipole (x sqrt(level scale)) skip.
+  int max_octave_difference = 2;  // Candidates on levels further apart are not compared.
   bool check_orientation = true;
   void Check() const;
 };
