@@ -76,6 +76,36 @@ std::vector<int> KeypointGrid::InWindow(const Eigen::Vector2d& uv, double radius
   return out;
 }
 
+void KeypointGrid::NearLine(const Eigen::Vector3d& line, double band, std::vector<int>* out,
+                            double lo_axis, double hi_axis) const {
+  out->clear();
+  const double a = line.x(), b = line.y(), c = line.z();
+  const double norm = std::sqrt(a * a + b * b);
+  if (norm < 1e-300) return;
+  // Walk along the axis the line is closer to; for each cell column (row) the band covers a
+  // contiguous range of cell rows (columns).
+  const bool by_column = std::abs(b) >= std::abs(a);
+  const int n_steps = by_column ? nx_ : ny_, n_other = by_column ? ny_ : nx_;
+  const double slope_den = by_column ? b : a, slope_num = by_column ? a : b;
+  const double extent = band * norm / std::abs(slope_den);  // Band height along the other axis.
+  const int i_begin = std::max(0, static_cast<int>(std::floor(std::max(-1.0, lo_axis) / cell_)));
+  const int i_end = std::min(n_steps - 1, static_cast<int>(std::floor(
+                                              std::min(static_cast<double>(n_steps) * cell_, hi_axis) / cell_)));
+  for (int i = i_begin; i <= i_end; ++i) {
+    const double t0 = static_cast<double>(i) * cell_, t1 = t0 + cell_;
+    const double o0 = -(slope_num * t0 + c) / slope_den, o1 = -(slope_num * t1 + c) / slope_den;
+    const double lo = std::min(o0, o1) - extent, hi = std::max(o0, o1) + extent;
+    if (hi < 0 || lo >= static_cast<double>(n_other) * cell_) continue;
+    const int j0 = std::max(0, static_cast<int>(std::floor(lo / cell_)));
+    const int j1 = std::min(n_other - 1, static_cast<int>(std::floor(hi / cell_)));
+    for (int j = j0; j <= j1; ++j) {
+      const int cx = by_column ? i : j, cy = by_column ? j : i;
+      const auto& cell = cells_[static_cast<size_t>(cy) * nx_ + cx];
+      out->insert(out->end(), cell.begin(), cell.end());
+    }
+  }
+}
+
 std::vector<bool> RotationConsistent(const std::vector<float>& angle_diff_deg, int bins) {
   std::vector<int> bin(angle_diff_deg.size());
   std::vector<int> count(bins, 0);
@@ -112,6 +142,7 @@ void EpipolarMatchOptions::Check() const {
   JVL_CHECK(epipolar_chi2 > 0, "matching: epipolar_chi2 must be > 0");
   JVL_CHECK(min_epipole_px >= 0, "matching: min_epipole_px must be >= 0");
   JVL_CHECK(max_octave_difference >= 0, "matching: max_octave_difference must be >= 0");
+  JVL_CHECK(min_depth > 0, "matching: min_depth must be > 0");
 }
 
 std::vector<int> MatchByProjection(const std::vector<ProjectedPoint>& points,
@@ -148,6 +179,35 @@ std::vector<int> MatchByProjection(const std::vector<ProjectedPoint>& points,
   return match;
 }
 
+namespace {
+
+// The image-2 segment of the epipolar line of a view-1 ray: in normalised coordinates the point at
+// depth lambda projects to v + s D with v the vanishing point of the ray, D = (t_xy a_z - t_z a_xy)
+// / a_z and s = 1 / (lambda a_z + t_z), where a = R21 x1 and t = t21 (derived from
+// x2 = (lambda a + t) / (lambda a_z + t_z)). Depths >= min_depth with positive depth in view 2
+// give s in (0, s_max].
+struct EpipolarSegment {
+  bool bounded = false;  // False: ray points backwards in view 2; no restriction applied.
+  Eigen::Vector2d v, d;  // Normalised coordinates.
+  double s_max = 0;
+};
+
+EpipolarSegment SegmentOf(const Rigid3d& cam2_from_cam1, const Eigen::Vector2d& xn1,
+                          double min_depth) {
+  EpipolarSegment seg;
+  const Eigen::Vector3d a = cam2_from_cam1.rotation() * xn1.homogeneous();
+  const Eigen::Vector3d& t = cam2_from_cam1.translation();
+  if (a.z() <= 1e-9) return seg;
+  seg.bounded = true;
+  seg.v = a.head<2>() / a.z();
+  seg.d = (t.head<2>() * a.z() - t.z() * a.head<2>()) / a.z();
+  const double den = min_depth * a.z() + t.z();
+  seg.s_max = den > 1e-9 ? 1.0 / den : std::numeric_limits<double>::infinity();
+  return seg;
+}
+
+}  // namespace
+
 Eigen::Matrix3d FundamentalFromPoses(const PinholeCamera& camera, const Rigid3d& cam1_from_world,
                                      const Rigid3d& cam2_from_world) {
   const Rigid3d cam2_from_cam1 = cam2_from_world * cam1_from_world.Inverse();
@@ -169,32 +229,65 @@ std::vector<std::pair<int, int>> MatchEpipolar(const PinholeCamera& camera, cons
   const Eigen::Vector3d c1_in_2 = cam2_from_world * cam1_from_world.Inverse().translation();
   const bool has_epipole = c1_in_2.z() > 1e-9;
   const Eigen::Vector2d epipole = has_epipole ? camera.Project(c1_in_2) : Eigen::Vector2d::Zero();
-  std::vector<int> candidates2;
+  std::vector<bool> allowed2(f2.size(), true);
+  double max_scale = 1.0;
   for (size_t j = 0; j < f2.size(); ++j) {
-    if (!used2.empty() && used2[j]) continue;
     const OrbKeypoint& k = f2.keypoints[j];
     const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
+    max_scale = std::max(max_scale, s);
+    if (!used2.empty() && used2[j]) allowed2[j] = false;
     if (has_epipole && (k.uv.cast<double>() - epipole).squaredNorm() <
                            options.min_epipole_px * options.min_epipole_px * s) {
-      continue;
+      allowed2[j] = false;
     }
-    candidates2.push_back(static_cast<int>(j));
   }
+  const KeypointGrid grid2(f2.keypoints, camera.width, camera.height, 16);
+  const Rigid3d cam2_from_cam1 = cam2_from_world * cam1_from_world.Inverse();
+  // Normalised -> pixel (affine part of K).
+  auto ToPixel = [&camera](const Eigen::Vector2d& xn) {
+    return Eigen::Vector2d(camera.fx * xn.x() + camera.cx, camera.fy * xn.y() + camera.cy);
+  };
+  const double max_band = std::sqrt(options.epipolar_chi2) * max_scale;
+  std::vector<int> near;
   std::vector<int> match(f1.size(), -1), dist(f1.size(), 256);
   std::vector<float> angle_diff(f1.size(), 0.f);
   for (size_t i = 0; i < f1.size(); ++i) {
     if (!used1.empty() && used1[i]) continue;
     const Eigen::Vector3d line = f21 * f1.keypoints[i].uv.cast<double>().homogeneous();
     const double inv_norm2 = 1.0 / std::max(1e-30, line.head<2>().squaredNorm());
+    const EpipolarSegment seg = SegmentOf(cam2_from_cam1, camera.Unproject(
+        f1.keypoints[i].uv.cast<double>()).head<2>(), options.min_depth);
+    const double d2 = seg.d.squaredNorm();
+    const double tol = max_band / camera.fx;  // Band in normalised units.
+    if (seg.bounded && d2 > 1e-24) {
+      // Walk only over the bounding range of the segment along the walking axis.
+      const Eigen::Vector2d p0 = ToPixel(seg.v);
+      const Eigen::Vector2d far = seg.v + std::min(seg.s_max, 1e6) * seg.d;
+      const Eigen::Vector2d p1 = ToPixel(far);
+      const bool by_column = std::abs(line.y()) >= std::abs(line.x());
+      const double a0 = by_column ? p0.x() : p0.y(), a1 = by_column ? p1.x() : p1.y();
+      grid2.NearLine(line, max_band, &near, std::min(a0, a1) - max_band,
+                     std::max(a0, a1) + max_band);
+    } else {
+      grid2.NearLine(line, max_band, &near);
+    }
     int best = 256, second = 256, best_j = -1;
-    for (int j : candidates2) {
+    for (int j : near) {
+      if (!allowed2[j]) continue;
       const OrbKeypoint& k = f2.keypoints[j];
       if (std::abs(k.octave - f1.keypoints[i].octave) > options.max_octave_difference) continue;
       const double r = line.x() * k.uv.x() + line.y() * k.uv.y() + line.z();
       const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
       if (r * r * inv_norm2 >= options.epipolar_chi2 * s * s) continue;
+      if (seg.bounded && d2 > 1e-24) {
+        const Eigen::Vector2d xn2 = camera.Unproject(k.uv.cast<double>()).head<2>();
+        const double along = (xn2 - seg.v).dot(seg.d) / d2;
+        const double margin = tol / std::sqrt(d2);
+        if (along < -margin || along > seg.s_max + margin) continue;
+      }
       const int d = HammingDistance(f1.descriptors[i], f2.descriptors[j]);
-      if (d < best) {
+      // Ties broken by the lower index so that the cell order does not matter.
+      if (d < best || (d == best && j < best_j)) {
         second = best;
         best = d, best_j = j;
       } else if (d < second) {

@@ -25,6 +25,13 @@ class KeypointGrid {
   // [min_octave, max_octave], in increasing index order.
   std::vector<int> InWindow(const Eigen::Vector2d& uv, double radius, int min_octave,
                             int max_octave) const;
+  // Keypoints in the grid cells that the band of half-width `band` px around the image line
+  // l = (a, b, c) (a u + b v + c = 0) crosses: a superset of the keypoints within `band` of it,
+  // each listed once, cell by cell.
+  // Only the part of the line whose coordinate along the walking axis lies in [lo, hi] (pixels)
+  // is visited.
+  void NearLine(const Eigen::Vector3d& line, double band, std::vector<int>* out,
+                double lo = -1e300, double hi = 1e300) const;
 
  private:
   const std::vector<OrbKeypoint>* keypoints_;
@@ -66,11 +73,14 @@ struct EpipolarMatchOptions {
   double epipolar_chi2 = 3.84;    // chi2(1 dof, 95%) times the level variance.
   double min_epipole_px = 10.0;   // Keypoints this close to the epipole (x sqrt(level scale)) skip.
   int max_octave_difference = 2;  // Candidates on levels further apart are not compared.
+  double min_depth = 1.0;         // m in view 1: the searched segment starts at this depth.
   bool check_orientation = true;
   void Check() const;
 };
 
 // Epipolar-constrained matching of unused keypoints of frame 1 to unused keypoints of frame 2.
+// Only the segment of the epipolar line that corresponds to depths in [min_depth, inf) in view 1
+// with positive depth in view 2 is searched.
 // used1/used2 may be empty. Returns (index in 1, index in 2) pairs ordered by index in 1.
 std::vector<std::pair<int, int>> MatchEpipolar(const PinholeCamera& camera, const OrbFeatures& f1,
                                                const Rigid3d& cam1_from_world,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -108,9 +109,14 @@ int HammingDistance(const Descriptor& a, const Descriptor& b) {
   int d = 0;
   for (int i = 0; i < 32; i += 8) {
     uint64_t x, y;
-    std::copy(a.begin() + i, a.begin() + i + 8, reinterpret_cast<uint8_t*>(&x));
-    std::copy(b.begin() + i, b.begin() + i + 8, reinterpret_cast<uint8_t*>(&y));
-    d += __builtin_popcountll(x ^ y);
+    std::memcpy(&x, a.data() + i, 8);
+    std::memcpy(&y, b.data() + i, 8);
+    // Bit count without relying on a hardware popcount instruction (SWAR reduction).
+    uint64_t v = x ^ y;
+    v = v - ((v >> 1) & 0x5555555555555555ULL);
+    v = (v & 0x3333333333333333ULL) + ((v >> 2) & 0x3333333333333333ULL);
+    v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0fULL;
+    d += static_cast<int>((v * 0x0101010101010101ULL) >> 56);
   }
   return d;
 }
