@@ -8,15 +8,17 @@ namespace {
 
 template <typename T>
 void CheckSize(const std::vector<T>& v, size_t n, const char* name, const std::string& what) {
-  JVL_CHECK(v.size() == n, what << ": " << name << " has " << v.size() << " values, expected " << n);
+  JVL_CHECK(v.size() == n,
+            what << ": " << name << " has " << v.size() << " values, expected " << n);
 }
 
 template <typename T>
-void CheckIndices(const std::vector<T>& v, size_t bound, const char* name, const std::string& what) {
+void CheckIndices(const std::vector<T>& v, size_t bound, const char* name,
+                  const std::string& what) {
   for (size_t i = 0; i < v.size(); ++i) {
-    JVL_CHECK(v[i] >= 0 && static_cast<size_t>(v[i]) < bound,
-              what << ": " << name << "[" << i << "] = " << v[i] << " out of range [0, " << bound
-                   << ")");
+    JVL_CHECK(
+        v[i] >= 0 && static_cast<size_t>(v[i]) < bound,
+        what << ": " << name << "[" << i << "] = " << v[i] << " out of range [0, " << bound << ")");
   }
 }
 

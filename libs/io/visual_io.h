@@ -39,9 +39,9 @@ struct VisualMapData {
   std::vector<int32_t> keypoint_octave;
   std::vector<float> keypoint_angle;         // Degrees.
   std::vector<uint8_t> keypoint_descriptor;  // P x 32
-  std::vector<double> mappoint_position;      // M x 3, world.
+  std::vector<double> mappoint_position;     // M x 3, world.
   std::vector<uint8_t> mappoint_descriptor;  // M x 32
-  std::vector<double> mappoint_normal;        // M x 3, unit mean viewing direction.
+  std::vector<double> mappoint_normal;       // M x 3, unit mean viewing direction.
   std::vector<int32_t> observation_keyframe, observation_keypoint, observation_mappoint;
   std::vector<int32_t> covisibility_edges;  // E x 2, keyframe rows, first < second.
   std::vector<int32_t> covisibility_weight;

@@ -1,11 +1,11 @@
 #include "io/visual_io.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <unistd.h>
 
 #include "core/check.h"
 

@@ -13,11 +13,16 @@ void KeyframeRuleOptions::Check() const {
 
 const char* ToString(KeyframeReason reason) {
   switch (reason) {
-    case KeyframeReason::kNone: return "none";
-    case KeyframeReason::kFirst: return "first";
-    case KeyframeReason::kDirection: return "direction";
-    case KeyframeReason::kConditions: return "conditions";
-    case KeyframeReason::kStarved: return "starved";
+    case KeyframeReason::kNone:
+      return "none";
+    case KeyframeReason::kFirst:
+      return "first";
+    case KeyframeReason::kDirection:
+      return "direction";
+    case KeyframeReason::kConditions:
+      return "conditions";
+    case KeyframeReason::kStarved:
+      return "starved";
   }
   return "unknown";
 }

@@ -17,10 +17,10 @@
 namespace jvl::mapping {
 
 struct KeyframeRuleOptions {
-  int min_frames_between = 1;   // C2: frames since the last keyframe (1 = every frame may be one).
-  int min_tracked = 50;         // C3.
+  int min_frames_between = 1;    // C2: frames since the last keyframe (1 = every frame may be one).
+  int min_tracked = 50;          // C3.
   double reference_ratio = 0.9;  // C4.
-  bool use_directions = true;   // Frames with a direction association are always keyframes.
+  bool use_directions = true;    // Frames with a direction association are always keyframes.
   void Check() const;
 };
 

@@ -57,8 +57,8 @@ std::vector<int> VisualMapBuilder::Track(const vision::OrbFeatures& features,
   const auto projected =
       PredictInView(map_, LocalPoints(), cam_from_world, options_.min_view_cos, &predicted);
   const vision::KeypointGrid grid(features.keypoints, map_.camera.width, map_.camera.height);
-  const std::vector<int> match = vision::MatchByProjection(projected, features, grid,
-                                                           map_.level_scales, options_.projection);
+  const std::vector<int> match =
+      vision::MatchByProjection(projected, features, grid, map_.level_scales, options_.projection);
   std::vector<int> keypoint_point(features.size(), -1);
   for (size_t i = 0; i < match.size(); ++i) {
     MapPoint& p = map_.points[predicted[i]];

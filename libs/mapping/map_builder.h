@@ -55,7 +55,7 @@ struct FrameReport {
   int new_points = 0;  // Triangulated (keyframes only).
   int fused = 0;       // Extra observations of new points in neighbour keyframes.
   int culled = 0;
-  double ms = 0;       // Association time (excluding ORB extraction).
+  double ms = 0;  // Association time (excluding ORB extraction).
 };
 
 class VisualMapBuilder {
@@ -73,10 +73,10 @@ class VisualMapBuilder {
   std::vector<int> Track(const vision::OrbFeatures& features, const Rigid3d& cam_from_world,
                          FrameReport* report);
   int ReferenceTracked(const std::vector<int>& match) const;
-  int CreateNewPoints(int keyframe);                      // map_points.cc
+  int CreateNewPoints(int keyframe);                                 // map_points.cc
   int FusePoints(int keyframe, const std::vector<int>& new_points);  // map_points.cc
-  int CullRecentPoints(int keyframe);                     // map_points.cc
-  std::vector<int> NeighbourKeyframes(int keyframe) const;  // map_points.cc
+  int CullRecentPoints(int keyframe);                                // map_points.cc
+  std::vector<int> NeighbourKeyframes(int keyframe) const;           // map_points.cc
 
   VisualMapOptions options_;
   VisualMap map_;

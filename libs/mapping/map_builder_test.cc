@@ -58,7 +58,8 @@ class Corridor {
       const Eigen::Vector3d p = cam_from_world * points_[i];
       if (p.z() < 1.0) continue;
       const int octave = std::clamp(
-          static_cast<int>(std::floor(std::log(reference_distance_[i] / p.norm()) / std::log(1.2) + 0.5)),
+          static_cast<int>(
+              std::floor(std::log(reference_distance_[i] / p.norm()) / std::log(1.2) + 0.5)),
           0, 7);
       const double s = std::pow(1.2, octave);
       const Eigen::Vector2d uv = cam.Project(p) + s * Eigen::Vector2d(noise(rng), noise(rng));

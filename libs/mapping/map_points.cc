@@ -11,7 +11,8 @@ namespace {
 double MedianDepth(const VisualMap& map, const Keyframe& kf) {
   std::vector<double> depth;
   for (int p : kf.mappoint) {
-    if (p >= 0 && !map.points[p].bad) depth.push_back((kf.cam_from_world * map.points[p].position).z());
+    if (p >= 0 && !map.points[p].bad)
+      depth.push_back((kf.cam_from_world * map.points[p].position).z());
   }
   if (depth.empty()) return 0;
   std::nth_element(depth.begin(), depth.begin() + depth.size() / 2, depth.end());
@@ -30,7 +31,8 @@ std::vector<bool> Used(const Keyframe& kf) {
 // keyframes with the largest overlap, which ORB-SLAM2 finds through the covisibility graph.
 std::vector<int> VisualMapBuilder::NeighbourKeyframes(int keyframe) const {
   std::vector<int> out;
-  for (int k = keyframe - 1; k >= 0 && static_cast<int>(out.size()) < options_.local_keyframes; --k) {
+  for (int k = keyframe - 1; k >= 0 && static_cast<int>(out.size()) < options_.local_keyframes;
+       --k) {
     out.push_back(k);
   }
   return out;
@@ -39,17 +41,18 @@ std::vector<int> VisualMapBuilder::NeighbourKeyframes(int keyframe) const {
 int VisualMapBuilder::CreateNewPoints(int keyframe) {
   const std::vector<int> neighbours = NeighbourKeyframes(keyframe);
   int created = 0;
-  for (size_t n = 0; n < neighbours.size() && static_cast<int>(n) < options_.triangulation_neighbors;
-       ++n) {
+  for (size_t n = 0;
+       n < neighbours.size() && static_cast<int>(n) < options_.triangulation_neighbors; ++n) {
     const Keyframe& kf = map_.keyframes[keyframe];
     const Keyframe& nb = map_.keyframes[neighbours[n]];
     // Too short a baseline for the scene depth gives no usable parallax (ORB-SLAM2, monocular).
-    const double baseline = (kf.world_from_cam.translation() - nb.world_from_cam.translation()).norm();
+    const double baseline =
+        (kf.world_from_cam.translation() - nb.world_from_cam.translation()).norm();
     const double depth = MedianDepth(map_, nb);
     if (depth > 0 && baseline / depth < options_.min_baseline_ratio) continue;
-    const auto pairs = vision::MatchEpipolar(map_.camera, kf.features, kf.cam_from_world, Used(kf),
-                                             nb.features, nb.cam_from_world, Used(nb),
-                                             map_.level_scales, options_.epipolar);
+    const auto pairs =
+        vision::MatchEpipolar(map_.camera, kf.features, kf.cam_from_world, Used(kf), nb.features,
+                              nb.cam_from_world, Used(nb), map_.level_scales, options_.epipolar);
     for (const auto& [i, j] : pairs) {
       const vision::OrbKeypoint& a = kf.features.keypoints[i];
       const vision::OrbKeypoint& b = nb.features.keypoints[j];

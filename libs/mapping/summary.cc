@@ -59,22 +59,21 @@ nlohmann::json Summarize(const VisualMapResult& result, const VisualMapStats& st
 
 std::string FormatSummary(const nlohmann::json& s) {
   char buf[1024];
-  std::snprintf(buf, sizeof(buf),
-                "frames %d  keyframes %d  map points %d  observations %d  covisibility edges %d\n"
-                "map points per keyframe: median %.0f  min %.0f;  observations per point %.2f\n"
-                "reprojection error: median %.3f px  p90 %.3f px\n"
-                "time per frame (median): %.1f ms (ORB %.1f ms, association %.1f ms)\n"
-                "keyframe reasons: %s",
-                s.at("frames").get<int>(), s.at("keyframes").get<int>(),
-                s.at("mappoints").get<int>(), s.at("observations").get<int>(),
-                s.at("covisibility_edges").get<int>(),
-                s.at("median_points_per_keyframe").get<double>(),
-                s.at("min_points_per_keyframe").get<double>(),
-                s.at("mean_observations_per_point").get<double>(),
-                s.at("median_reprojection_px").get<double>(),
-                s.at("p90_reprojection_px").get<double>(), s.at("median_frame_ms").get<double>(),
-                s.at("median_orb_ms").get<double>(), s.at("median_association_ms").get<double>(),
-                s.at("keyframe_reasons").dump().c_str());
+  std::snprintf(
+      buf, sizeof(buf),
+      "frames %d  keyframes %d  map points %d  observations %d  covisibility edges %d\n"
+      "map points per keyframe: median %.0f  min %.0f;  observations per point %.2f\n"
+      "reprojection error: median %.3f px  p90 %.3f px\n"
+      "time per frame (median): %.1f ms (ORB %.1f ms, association %.1f ms)\n"
+      "keyframe reasons: %s",
+      s.at("frames").get<int>(), s.at("keyframes").get<int>(), s.at("mappoints").get<int>(),
+      s.at("observations").get<int>(), s.at("covisibility_edges").get<int>(),
+      s.at("median_points_per_keyframe").get<double>(),
+      s.at("min_points_per_keyframe").get<double>(),
+      s.at("mean_observations_per_point").get<double>(),
+      s.at("median_reprojection_px").get<double>(), s.at("p90_reprojection_px").get<double>(),
+      s.at("median_frame_ms").get<double>(), s.at("median_orb_ms").get<double>(),
+      s.at("median_association_ms").get<double>(), s.at("keyframe_reasons").dump().c_str());
   return buf;
 }
 

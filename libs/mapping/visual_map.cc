@@ -86,7 +86,8 @@ int PredictOctave(const MapPoint& point, double distance, const VisualMap& map) 
 
 std::vector<vision::ProjectedPoint> PredictInView(const VisualMap& map,
                                                   const std::vector<int>& points,
-                                                  const Rigid3d& cam_from_world, double min_view_cos,
+                                                  const Rigid3d& cam_from_world,
+                                                  double min_view_cos,
                                                   std::vector<int>* predicted) {
   const Eigen::Vector3d center = cam_from_world.Inverse().translation();
   std::vector<vision::ProjectedPoint> out;

@@ -68,8 +68,8 @@ int PredictOctave(const MapPoint& point, double distance, const VisualMap& map);
 // mean viewing direction. Returns the predictions; predicted[i] is the map point of row i.
 std::vector<vision::ProjectedPoint> PredictInView(const VisualMap& map,
                                                   const std::vector<int>& points,
-                                                  const Rigid3d& cam_from_world, double min_view_cos,
-                                                  std::vector<int>* predicted);
+                                                  const Rigid3d& cam_from_world,
+                                                  double min_view_cos, std::vector<int>* predicted);
 
 struct CovisibilityEdge {
   int a = 0, b = 0;  // Keyframe rows, a < b.

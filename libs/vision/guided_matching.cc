@@ -10,7 +10,8 @@ namespace jvl::vision {
 namespace {
 
 // Resolves keypoints claimed by several queries: the one with the smallest distance keeps it.
-void ResolveConflicts(std::vector<int>* match, const std::vector<int>& distance, size_t n_keypoints) {
+void ResolveConflicts(std::vector<int>* match, const std::vector<int>& distance,
+                      size_t n_keypoints) {
   std::vector<int> owner(n_keypoints, -1);
   for (size_t i = 0; i < match->size(); ++i) {
     const int k = (*match)[i];
@@ -89,8 +90,9 @@ void KeypointGrid::NearLine(const Eigen::Vector3d& line, double band, std::vecto
   const double slope_den = by_column ? b : a, slope_num = by_column ? a : b;
   const double extent = band * norm / std::abs(slope_den);  // Band height along the other axis.
   const int i_begin = std::max(0, static_cast<int>(std::floor(std::max(-1.0, lo_axis) / cell_)));
-  const int i_end = std::min(n_steps - 1, static_cast<int>(std::floor(
-                                              std::min(static_cast<double>(n_steps) * cell_, hi_axis) / cell_)));
+  const int i_end =
+      std::min(n_steps - 1, static_cast<int>(std::floor(
+                                std::min(static_cast<double>(n_steps) * cell_, hi_axis) / cell_)));
   for (int i = i_begin; i <= i_end; ++i) {
     const double t0 = static_cast<double>(i) * cell_, t1 = t0 + cell_;
     const double o0 = -(slope_num * t0 + c) / slope_den, o1 = -(slope_num * t1 + c) / slope_den;
@@ -216,14 +218,11 @@ Eigen::Matrix3d FundamentalFromPoses(const PinholeCamera& camera, const Rigid3d&
   return k_inv.transpose() * e * k_inv;
 }
 
-std::vector<std::pair<int, int>> MatchEpipolar(const PinholeCamera& camera, const OrbFeatures& f1,
-                                               const Rigid3d& cam1_from_world,
-                                               const std::vector<bool>& used1,
-                                               const OrbFeatures& f2,
-                                               const Rigid3d& cam2_from_world,
-                                               const std::vector<bool>& used2,
-                                               const std::vector<double>& level_scales,
-                                               const EpipolarMatchOptions& options) {
+std::vector<std::pair<int, int>> MatchEpipolar(
+    const PinholeCamera& camera, const OrbFeatures& f1, const Rigid3d& cam1_from_world,
+    const std::vector<bool>& used1, const OrbFeatures& f2, const Rigid3d& cam2_from_world,
+    const std::vector<bool>& used2, const std::vector<double>& level_scales,
+    const EpipolarMatchOptions& options) {
   const Eigen::Matrix3d f21 = FundamentalFromPoses(camera, cam1_from_world, cam2_from_world);
   // Epipole in view 2: the centre of camera 1 projected.
   const Eigen::Vector3d c1_in_2 = cam2_from_world * cam1_from_world.Inverse().translation();
@@ -255,8 +254,9 @@ std::vector<std::pair<int, int>> MatchEpipolar(const PinholeCamera& camera, cons
     if (!used1.empty() && used1[i]) continue;
     const Eigen::Vector3d line = f21 * f1.keypoints[i].uv.cast<double>().homogeneous();
     const double inv_norm2 = 1.0 / std::max(1e-30, line.head<2>().squaredNorm());
-    const EpipolarSegment seg = SegmentOf(cam2_from_cam1, camera.Unproject(
-        f1.keypoints[i].uv.cast<double>()).head<2>(), options.min_depth);
+    const EpipolarSegment seg =
+        SegmentOf(cam2_from_cam1, camera.Unproject(f1.keypoints[i].uv.cast<double>()).head<2>(),
+                  options.min_depth);
     const double d2 = seg.d.squaredNorm();
     const double tol = max_band / camera.fx;  // Band in normalised units.
     if (seg.bounded && d2 > 1e-24) {

@@ -30,8 +30,8 @@ class KeypointGrid {
   // each listed once, cell by cell.
   // Only the part of the line whose coordinate along the walking axis lies in [lo, hi] (pixels)
   // is visited.
-  void NearLine(const Eigen::Vector3d& line, double band, std::vector<int>* out,
-                double lo = -1e300, double hi = 1e300) const;
+  void NearLine(const Eigen::Vector3d& line, double band, std::vector<int>* out, double lo = -1e300,
+                double hi = 1e300) const;
 
  private:
   const std::vector<OrbKeypoint>* keypoints_;
@@ -44,9 +44,9 @@ class KeypointGrid {
 std::vector<bool> RotationConsistent(const std::vector<float>& angle_diff_deg, int bins = 30);
 
 struct ProjectionMatchOptions {
-  double window_px = 4.0;     // Search radius at level 0; multiplied by the level scale.
-  int max_distance = 100;     // Hamming threshold (ORB-SLAM2 TH_HIGH).
-  double ratio = 0.8;         // Best/second-best ratio (applied when both are on one level).
+  double window_px = 4.0;  // Search radius at level 0; multiplied by the level scale.
+  int max_distance = 100;  // Hamming threshold (ORB-SLAM2 TH_HIGH).
+  double ratio = 0.8;      // Best/second-best ratio (applied when both are on one level).
   bool check_orientation = true;
   void Check() const;
 };
@@ -82,14 +82,11 @@ struct EpipolarMatchOptions {
 // Only the segment of the epipolar line that corresponds to depths in [min_depth, inf) in view 1
 // with positive depth in view 2 is searched.
 // used1/used2 may be empty. Returns (index in 1, index in 2) pairs ordered by index in 1.
-std::vector<std::pair<int, int>> MatchEpipolar(const PinholeCamera& camera, const OrbFeatures& f1,
-                                               const Rigid3d& cam1_from_world,
-                                               const std::vector<bool>& used1,
-                                               const OrbFeatures& f2,
-                                               const Rigid3d& cam2_from_world,
-                                               const std::vector<bool>& used2,
-                                               const std::vector<double>& level_scales,
-                                               const EpipolarMatchOptions& options);
+std::vector<std::pair<int, int>> MatchEpipolar(
+    const PinholeCamera& camera, const OrbFeatures& f1, const Rigid3d& cam1_from_world,
+    const std::vector<bool>& used1, const OrbFeatures& f2, const Rigid3d& cam2_from_world,
+    const std::vector<bool>& used2, const std::vector<double>& level_scales,
+    const EpipolarMatchOptions& options);
 
 // Fundamental matrix F21 with x2^T F21 x1 = 0 for pixels x1 in view 1 and x2 in view 2.
 Eigen::Matrix3d FundamentalFromPoses(const PinholeCamera& camera, const Rigid3d& cam1_from_world,

@@ -49,8 +49,8 @@ struct Scene {
       if (p.z() <= 0) continue;
       const Eigen::Vector2d uv = cam.Project(p) + Eigen::Vector2d(noise(rng), noise(rng));
       if (!cam.InImage(uv)) continue;
-      f.keypoints.push_back({uv.cast<float>(), static_cast<int>(i % 3),
-                             static_cast<float>(40 + noise(rng)), 30.f});
+      f.keypoints.push_back(
+          {uv.cast<float>(), static_cast<int>(i % 3), static_cast<float>(40 + noise(rng)), 30.f});
       f.descriptors.push_back(FlipBits(descriptors[i], 6, rng));
       truth->push_back(static_cast<int>(i));
       // A confuser with the same appearance somewhere else in the image.
@@ -142,9 +142,9 @@ TEST(GuidedMatching, FundamentalMatrixSatisfiesEpipolarConstraint) {
 TEST(GuidedMatching, RotationHistogramKeepsTheDominantBins) {
   std::vector<float> diffs;
   for (int i = 0; i < 50; ++i) diffs.push_back(5.f + 0.1f * i);  // Bin 0.
-  for (int i = 0; i < 20; ++i) diffs.push_back(-3.f);           // Wraps to bin 29.
-  for (int i = 0; i < 10; ++i) diffs.push_back(13.f);           // Bin 1.
-  diffs.push_back(180.f);                                       // Alone: rejected.
+  for (int i = 0; i < 20; ++i) diffs.push_back(-3.f);            // Wraps to bin 29.
+  for (int i = 0; i < 10; ++i) diffs.push_back(13.f);            // Bin 1.
+  diffs.push_back(180.f);                                        // Alone: rejected.
   diffs.push_back(95.f);
   const std::vector<bool> keep = RotationConsistent(diffs);
   for (int i = 0; i < 80; ++i) EXPECT_TRUE(keep[i]) << i;

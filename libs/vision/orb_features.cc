@@ -19,8 +19,8 @@ constexpr int kHalfPatch = 15;  // BRIEF patch 31x31 (Rublee et al. 2011).
 float IntensityCentroidAngle(const cv::Mat& level, int x, int y) {
   int64_t m01 = 0, m10 = 0;
   for (int dy = -kHalfPatch; dy <= kHalfPatch; ++dy) {
-    const int half_width = static_cast<int>(std::floor(
-        std::sqrt(static_cast<double>(kHalfPatch * kHalfPatch - dy * dy)) + 1e-9));
+    const int half_width = static_cast<int>(
+        std::floor(std::sqrt(static_cast<double>(kHalfPatch * kHalfPatch - dy * dy)) + 1e-9));
     const uint8_t* row = level.ptr<uint8_t>(y + dy);
     for (int dx = -half_width; dx <= half_width; ++dx) {
       const int v = row[x + dx];
@@ -59,11 +59,12 @@ std::vector<cv::KeyPoint> DetectInCell(const cv::Mat& level, int x0, int y0, int
   if (corners.empty()) cv::FAST(level(roi), corners, o.fast_min_threshold, true);
   for (auto& c : corners) c.pt += cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y));
   // Strongest first; ties by position for determinism.
-  std::stable_sort(corners.begin(), corners.end(), [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
-    if (a.response != b.response) return a.response > b.response;
-    if (a.pt.y != b.pt.y) return a.pt.y < b.pt.y;
-    return a.pt.x < b.pt.x;
-  });
+  std::stable_sort(corners.begin(), corners.end(),
+                   [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
+                     if (a.response != b.response) return a.response > b.response;
+                     if (a.pt.y != b.pt.y) return a.pt.y < b.pt.y;
+                     return a.pt.x < b.pt.x;
+                   });
   return corners;
 }
 
@@ -93,9 +94,9 @@ std::vector<cv::KeyPoint> DetectLevel(const cv::Mat& level, int wanted, const Or
     }
     const size_t room = static_cast<size_t>(wanted) - kept.size();
     if (layer.size() > room) {
-      std::stable_sort(layer.begin(), layer.end(), [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
-        return a.response > b.response;
-      });
+      std::stable_sort(
+          layer.begin(), layer.end(),
+          [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.response > b.response; });
       layer.resize(room);
     }
     kept.insert(kept.end(), layer.begin(), layer.end());
@@ -175,8 +176,8 @@ OrbFeatures ExtractOrb(const cv::Mat& image, const OrbOptions& options) {
   out.keypoints.reserve(all.size());
   out.descriptors.resize(all.size());
   for (size_t i = 0; i < all.size(); ++i) {
-    out.keypoints.push_back({Eigen::Vector2f(all[i].pt.x, all[i].pt.y), all[i].octave,
-                             all[i].angle, all[i].response});
+    out.keypoints.push_back(
+        {Eigen::Vector2f(all[i].pt.x, all[i].pt.y), all[i].octave, all[i].angle, all[i].response});
     std::copy(desc.ptr<uint8_t>(static_cast<int>(i)), desc.ptr<uint8_t>(static_cast<int>(i)) + 32,
               out.descriptors[i].begin());
   }

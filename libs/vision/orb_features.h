@@ -18,13 +18,13 @@ using Descriptor = std::array<uint8_t, 32>;
 int HammingDistance(const Descriptor& a, const Descriptor& b);
 
 struct OrbOptions {
-  int num_features = 2000;       // Total over all levels (ORB-SLAM2 KITTI setting).
-  int num_levels = 8;            // Pyramid levels.
-  double scale_factor = 1.2;     // Scale between consecutive levels.
-  int fast_threshold = 20;       // FAST threshold tried first in every cell.
-  int fast_min_threshold = 7;    // Retried in cells where the first threshold finds nothing.
-  int cell_size = 30;            // Grid cell size in pixels of each level.
-  int edge_threshold = 19;       // Border (level pixels) without features (BRIEF patch 31).
+  int num_features = 2000;     // Total over all levels (ORB-SLAM2 KITTI setting).
+  int num_levels = 8;          // Pyramid levels.
+  double scale_factor = 1.2;   // Scale between consecutive levels.
+  int fast_threshold = 20;     // FAST threshold tried first in every cell.
+  int fast_min_threshold = 7;  // Retried in cells where the first threshold finds nothing.
+  int cell_size = 30;          // Grid cell size in pixels of each level.
+  int edge_threshold = 19;     // Border (level pixels) without features (BRIEF patch 31).
   void Check() const;
 };
 

@@ -52,12 +52,18 @@ void TriangulationOptions::Check() const {
 
 const char* ToString(TriangulationStatus status) {
   switch (status) {
-    case TriangulationStatus::kOk: return "ok";
-    case TriangulationStatus::kLowParallax: return "low_parallax";
-    case TriangulationStatus::kNoSolution: return "no_solution";
-    case TriangulationStatus::kBehindCamera: return "behind_camera";
-    case TriangulationStatus::kReprojection: return "reprojection";
-    case TriangulationStatus::kScaleInconsistent: return "scale_inconsistent";
+    case TriangulationStatus::kOk:
+      return "ok";
+    case TriangulationStatus::kLowParallax:
+      return "low_parallax";
+    case TriangulationStatus::kNoSolution:
+      return "no_solution";
+    case TriangulationStatus::kBehindCamera:
+      return "behind_camera";
+    case TriangulationStatus::kReprojection:
+      return "reprojection";
+    case TriangulationStatus::kScaleInconsistent:
+      return "scale_inconsistent";
   }
   return "unknown";
 }

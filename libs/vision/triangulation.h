@@ -28,7 +28,7 @@ std::optional<Eigen::Vector3d> TriangulateMidpoint(const Rigid3d& cam1_from_worl
                                                    const Eigen::Vector2d& xn2);
 
 struct TriangulationOptions {
-  double max_cos_parallax = 0.9998;  // Rays must differ by more than ~1.15 deg (ORB-SLAM2).
+  double max_cos_parallax = 0.9998;      // Rays must differ by more than ~1.15 deg (ORB-SLAM2).
   double max_reprojection_chi2 = 5.991;  // chi2(2 dof, 95%) times the level variance.
   double scale_consistency = 1.5;        // Allowed factor between distance and octave ratios.
   void Check() const;

@@ -24,7 +24,7 @@ Eigen::Vector2d Normalised(const Rigid3d& cam_from_world, const Eigen::Vector3d&
 TEST(Triangulation, DltAndMidpointRecoverKnownPoints) {
   const TwoViews v;
   for (const Eigen::Vector3d& x : {Eigen::Vector3d(2, -1, 8), Eigen::Vector3d(-5, 1.5, 20),
-                                  Eigen::Vector3d(0.3, 0.2, 4), Eigen::Vector3d(10, -2, 45)}) {
+                                   Eigen::Vector3d(0.3, 0.2, 4), Eigen::Vector3d(10, -2, 45)}) {
     const Eigen::Vector2d a = Normalised(v.cam1_from_world, x);
     const Eigen::Vector2d b = Normalised(v.cam2_from_world, x);
     const auto dlt = TriangulateDlt(v.cam1_from_world, v.cam2_from_world, a, b);

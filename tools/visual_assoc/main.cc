@@ -30,8 +30,8 @@ int main(int argc, char** argv) {
   tools::AddVisualMapFlags(cli, &options);
   return tool.Run(argc, argv, [&] {
     options.Check();
-    auto dataset = io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format),
-                                   ParseFrameRange(frames));
+    auto dataset =
+        io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
     tool.SetDatasetId(dataset->id());
     for (const auto& f : dataset->KeyFiles()) tool.AddInput(f);
     const Trajectory prior = io::ReadTrajectory(prior_path);
@@ -47,10 +47,11 @@ int main(int argc, char** argv) {
         dataset->calibration().Camera(0), poses, direction_frames,
         [&](int64_t f) { return dataset->LoadImage(f, 0); }, options, tool.threads(),
         [&](const mapping::FrameReport& r) {
-          spdlog::debug("frame {}: {} keypoints, tracked {}/{}, keyframe {} ({}), new {}, fused {}, "
-                        "culled {}, {:.1f} ms",
-                        r.frame, r.keypoints, r.tracked, r.candidates, r.keyframe,
-                        mapping::ToString(r.reason), r.new_points, r.fused, r.culled, r.ms);
+          spdlog::debug(
+              "frame {}: {} keypoints, tracked {}/{}, keyframe {} ({}), new {}, fused {}, "
+              "culled {}, {:.1f} ms",
+              r.frame, r.keypoints, r.tracked, r.candidates, r.keyframe,
+              mapping::ToString(r.reason), r.new_points, r.fused, r.culled, r.ms);
           progress.Tick();
         });
     io::VisualMapData data =
