@@ -218,76 +218,93 @@ Eigen::Matrix3d FundamentalFromPoses(const PinholeCamera& camera, const Rigid3d&
   return k_inv.transpose() * e * k_inv;
 }
 
+namespace {
+
+// Keypoints of view 2 that may be matched: unused and not too close to the epipole, where the
+// epipolar lines converge and parallax vanishes (ORB-SLAM2 SearchForTriangulation).
+std::vector<bool> AllowedInView2(const PinholeCamera& camera, const OrbFeatures& f2,
+                                 const Rigid3d& cam2_from_cam1, const std::vector<bool>& used2,
+                                 const std::vector<double>& level_scales,
+                                 const EpipolarMatchOptions& options) {
+  const Eigen::Vector3d c1_in_2 = cam2_from_cam1.translation();
+  const bool has_epipole = c1_in_2.z() > 1e-9;
+  const Eigen::Vector2d epipole = has_epipole ? camera.Project(c1_in_2) : Eigen::Vector2d::Zero();
+  std::vector<bool> allowed(f2.size(), true);
+  for (size_t j = 0; j < f2.size(); ++j) {
+    const OrbKeypoint& k = f2.keypoints[j];
+    const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
+    if (!used2.empty() && used2[j]) allowed[j] = false;
+    if (has_epipole && (k.uv.cast<double>() - epipole).squaredNorm() <
+                           options.min_epipole_px * options.min_epipole_px * s) {
+      allowed[j] = false;
+    }
+  }
+  return allowed;
+}
+
+// Keypoints in the grid cells along the segment (or the whole line when unbounded).
+void SegmentCandidates(const KeypointGrid& grid, const PinholeCamera& camera,
+                       const Eigen::Vector3d& line, const EpipolarSegment& seg, double band,
+                       std::vector<int>* near) {
+  if (!seg.bounded || seg.d.squaredNorm() < 1e-24) {
+    grid.NearLine(line, band, near);
+    return;
+  }
+  auto to_pixel = [&camera](const Eigen::Vector2d& xn) {
+    return Eigen::Vector2d(camera.fx * xn.x() + camera.cx, camera.fy * xn.y() + camera.cy);
+  };
+  const Eigen::Vector2d p0 = to_pixel(seg.v);
+  const Eigen::Vector2d p1 = to_pixel(seg.v + std::min(seg.s_max, 1e6) * seg.d);
+  const bool by_column = std::abs(line.y()) >= std::abs(line.x());  // As NearLine walks.
+  const double a0 = by_column ? p0.x() : p0.y(), a1 = by_column ? p1.x() : p1.y();
+  grid.NearLine(line, band, near, std::min(a0, a1) - band, std::max(a0, a1) + band);
+}
+
+// Whether a view-2 pixel projects within the depth segment (with a margin of `band` px).
+bool OnSegment(const PinholeCamera& camera, const EpipolarSegment& seg, const Eigen::Vector2f& uv,
+               double band) {
+  const double d2 = seg.d.squaredNorm();
+  if (!seg.bounded || d2 < 1e-24) return true;
+  const Eigen::Vector2d xn2 = camera.Unproject(uv.cast<double>()).head<2>();
+  const double along = (xn2 - seg.v).dot(seg.d) / d2;
+  const double margin = band / camera.fx / std::sqrt(d2);
+  return along >= -margin && along <= seg.s_max + margin;
+}
+
+}  // namespace
+
 std::vector<std::pair<int, int>> MatchEpipolar(
     const PinholeCamera& camera, const OrbFeatures& f1, const Rigid3d& cam1_from_world,
     const std::vector<bool>& used1, const OrbFeatures& f2, const Rigid3d& cam2_from_world,
     const std::vector<bool>& used2, const std::vector<double>& level_scales,
     const EpipolarMatchOptions& options) {
   const Eigen::Matrix3d f21 = FundamentalFromPoses(camera, cam1_from_world, cam2_from_world);
-  // Epipole in view 2: the centre of camera 1 projected.
-  const Eigen::Vector3d c1_in_2 = cam2_from_world * cam1_from_world.Inverse().translation();
-  const bool has_epipole = c1_in_2.z() > 1e-9;
-  const Eigen::Vector2d epipole = has_epipole ? camera.Project(c1_in_2) : Eigen::Vector2d::Zero();
-  std::vector<bool> allowed2(f2.size(), true);
-  double max_scale = 1.0;
-  for (size_t j = 0; j < f2.size(); ++j) {
-    const OrbKeypoint& k = f2.keypoints[j];
-    const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
-    max_scale = std::max(max_scale, s);
-    if (!used2.empty() && used2[j]) allowed2[j] = false;
-    if (has_epipole && (k.uv.cast<double>() - epipole).squaredNorm() <
-                           options.min_epipole_px * options.min_epipole_px * s) {
-      allowed2[j] = false;
-    }
-  }
-  const KeypointGrid grid2(f2.keypoints, camera.width, camera.height, 16);
   const Rigid3d cam2_from_cam1 = cam2_from_world * cam1_from_world.Inverse();
-  // Normalised -> pixel (affine part of K).
-  auto ToPixel = [&camera](const Eigen::Vector2d& xn) {
-    return Eigen::Vector2d(camera.fx * xn.x() + camera.cx, camera.fy * xn.y() + camera.cy);
-  };
-  const double max_band = std::sqrt(options.epipolar_chi2) * max_scale;
+  const std::vector<bool> allowed2 =
+      AllowedInView2(camera, f2, cam2_from_cam1, used2, level_scales, options);
+  const KeypointGrid grid2(f2.keypoints, camera.width, camera.height, 16);
+  const double max_band = std::sqrt(options.epipolar_chi2) * level_scales.back();
   std::vector<int> near;
   std::vector<int> match(f1.size(), -1), dist(f1.size(), 256);
   std::vector<float> angle_diff(f1.size(), 0.f);
   for (size_t i = 0; i < f1.size(); ++i) {
     if (!used1.empty() && used1[i]) continue;
-    const Eigen::Vector3d line = f21 * f1.keypoints[i].uv.cast<double>().homogeneous();
+    const OrbKeypoint& k1 = f1.keypoints[i];
+    const Eigen::Vector3d line = f21 * k1.uv.cast<double>().homogeneous();
     const double inv_norm2 = 1.0 / std::max(1e-30, line.head<2>().squaredNorm());
-    const EpipolarSegment seg =
-        SegmentOf(cam2_from_cam1, camera.Unproject(f1.keypoints[i].uv.cast<double>()).head<2>(),
-                  options.min_depth);
-    const double d2 = seg.d.squaredNorm();
-    const double tol = max_band / camera.fx;  // Band in normalised units.
-    if (seg.bounded && d2 > 1e-24) {
-      // Walk only over the bounding range of the segment along the walking axis.
-      const Eigen::Vector2d p0 = ToPixel(seg.v);
-      const Eigen::Vector2d far = seg.v + std::min(seg.s_max, 1e6) * seg.d;
-      const Eigen::Vector2d p1 = ToPixel(far);
-      const bool by_column = std::abs(line.y()) >= std::abs(line.x());
-      const double a0 = by_column ? p0.x() : p0.y(), a1 = by_column ? p1.x() : p1.y();
-      grid2.NearLine(line, max_band, &near, std::min(a0, a1) - max_band,
-                     std::max(a0, a1) + max_band);
-    } else {
-      grid2.NearLine(line, max_band, &near);
-    }
+    const EpipolarSegment seg = SegmentOf(
+        cam2_from_cam1, camera.Unproject(k1.uv.cast<double>()).head<2>(), options.min_depth);
+    SegmentCandidates(grid2, camera, line, seg, max_band, &near);
     int best = 256, second = 256, best_j = -1;
     for (int j : near) {
-      if (!allowed2[j]) continue;
       const OrbKeypoint& k = f2.keypoints[j];
-      if (std::abs(k.octave - f1.keypoints[i].octave) > options.max_octave_difference) continue;
+      if (!allowed2[j] || std::abs(k.octave - k1.octave) > options.max_octave_difference) continue;
       const double r = line.x() * k.uv.x() + line.y() * k.uv.y() + line.z();
       const double s = level_scales[std::min<size_t>(k.octave, level_scales.size() - 1)];
       if (r * r * inv_norm2 >= options.epipolar_chi2 * s * s) continue;
-      if (seg.bounded && d2 > 1e-24) {
-        const Eigen::Vector2d xn2 = camera.Unproject(k.uv.cast<double>()).head<2>();
-        const double along = (xn2 - seg.v).dot(seg.d) / d2;
-        const double margin = tol / std::sqrt(d2);
-        if (along < -margin || along > seg.s_max + margin) continue;
-      }
+      if (!OnSegment(camera, seg, k.uv, max_band)) continue;
       const int d = HammingDistance(f1.descriptors[i], f2.descriptors[j]);
-      // Ties broken by the lower index so that the cell order does not matter.
-      if (d < best || (d == best && j < best_j)) {
+      if (d < best || (d == best && j < best_j)) {  // Ties: lower index, whatever the cell order.
         second = best;
         best = d, best_j = j;
       } else if (d < second) {
@@ -297,7 +314,7 @@ std::vector<std::pair<int, int>> MatchEpipolar(
     if (best_j < 0 || best > options.max_distance || best > options.ratio * second) continue;
     match[i] = best_j;
     dist[i] = best;
-    angle_diff[i] = f2.keypoints[best_j].angle - f1.keypoints[i].angle;
+    angle_diff[i] = f2.keypoints[best_j].angle - k1.angle;
   }
   ResolveConflicts(&match, dist, f2.size());
   if (options.check_orientation) ApplyRotationCheck(&match, angle_diff);
