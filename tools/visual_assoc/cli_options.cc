@@ -21,6 +21,7 @@ void AddVisualMapFlags(CLI::App& cli, mapping::VisualMapOptions* o) {
   add("--epipolar-chi2", o->epipolar.epipolar_chi2, "Epipolar distance bound (x level variance)");
   add("--epipolar-max-octave-diff", o->epipolar.max_octave_difference,
       "Largest octave difference of epipolar candidates");
+  add("--epipolar-min-depth", o->epipolar.min_depth, "Nearest depth (m) searched along the line");
   add("--min-parallax-cos", o->triangulation.max_cos_parallax,
       "Triangulate only if the cosine of the ray angle is below this");
   add("--reprojection-chi2", o->triangulation.max_reprojection_chi2,
