@@ -1,0 +1,115 @@
+#include "io/visual_io.h"
+
+#include "core/check.h"
+#include "io/trajectory_io.h"
+
+namespace jvl::io {
+namespace {
+
+template <typename T>
+void CheckSize(const std::vector<T>& v, size_t n, const char* name, const std::string& what) {
+  JVL_CHECK(v.size() == n,
+            what << ": " << name << " has " << v.size() << " values, expected " << n);
+}
+
+template <typename T>
+void CheckIndices(const std::vector<T>& v, size_t bound, const char* name,
+                  const std::string& what) {
+  for (size_t i = 0; i < v.size(); ++i) {
+    JVL_CHECK(
+        v[i] >= 0 && static_cast<size_t>(v[i]) < bound,
+        what << ": " << name << "[" << i << "] = " << v[i] << " out of range [0, " << bound << ")");
+  }
+}
+
+}  // namespace
+
+void VisualMapData::Check(const std::string& what) const {
+  keyframes.Check((what + " keyframes").c_str());
+  const size_t p = num_keypoints(), m = num_mappoints(), o = num_observations(), e = num_edges();
+  CheckSize(keypoint_uv, 2 * p, "keypoints/uv", what);
+  CheckSize(keypoint_octave, p, "keypoints/octave", what);
+  CheckSize(keypoint_angle, p, "keypoints/angle", what);
+  CheckSize(keypoint_descriptor, 32 * p, "keypoints/descriptor", what);
+  CheckSize(mappoint_position, 3 * m, "mappoints/position", what);
+  CheckSize(mappoint_descriptor, 32 * m, "mappoints/descriptor", what);
+  CheckSize(mappoint_normal, 3 * m, "mappoints/normal", what);
+  CheckSize(observation_keyframe, o, "observations/keyframe", what);
+  CheckSize(observation_keypoint, o, "observations/keypoint", what);
+  CheckSize(covisibility_edges, 2 * e, "covisibility/edges", what);
+  CheckIndices(keypoint_keyframe, keyframes.size(), "keypoints/keyframe", what);
+  CheckIndices(observation_keyframe, keyframes.size(), "observations/keyframe", what);
+  CheckIndices(observation_keypoint, p, "observations/keypoint", what);
+  CheckIndices(observation_mappoint, m, "observations/mappoint", what);
+  CheckIndices(covisibility_edges, keyframes.size(), "covisibility/edges", what);
+  for (size_t i = 0; i < o; ++i) {
+    JVL_CHECK(keypoint_keyframe[observation_keypoint[i]] == observation_keyframe[i],
+              what << ": observation " << i << " refers to a keypoint of another keyframe");
+  }
+}
+
+void WriteVisualMap(const std::string& path, const VisualMapData& d, const Provenance& provenance) {
+  d.Check(path);
+  const int64_t p = static_cast<int64_t>(d.num_keypoints());
+  const int64_t m = static_cast<int64_t>(d.num_mappoints());
+  H5Writer w(path, kVisualSchema, kVisualSchemaVersion);
+  const PinholeCamera& c = d.camera;
+  w.WriteArray<double>("camera", {c.fx, c.fy, c.cx, c.cy, static_cast<double>(c.width),
+                                  static_cast<double>(c.height)});
+  w.WriteJson("orb", {{"scale_factor", d.scale_factor}, {"num_levels", d.num_levels}});
+  WriteTrajectoryGroup(w, "keyframes", d.keyframes);
+  w.WriteArray("keypoints/keyframe", d.keypoint_keyframe);
+  w.WriteArray("keypoints/uv", d.keypoint_uv, {p, 2});
+  w.WriteArray("keypoints/octave", d.keypoint_octave);
+  w.WriteArray("keypoints/angle", d.keypoint_angle);
+  w.WriteArray("keypoints/descriptor", d.keypoint_descriptor, {p, 32});
+  w.WriteArray("mappoints/position", d.mappoint_position, {m, 3});
+  w.WriteArray("mappoints/descriptor", d.mappoint_descriptor, {m, 32});
+  w.WriteArray("mappoints/normal", d.mappoint_normal, {m, 3});
+  w.WriteArray("observations/keyframe", d.observation_keyframe);
+  w.WriteArray("observations/keypoint", d.observation_keypoint);
+  w.WriteArray("observations/mappoint", d.observation_mappoint);
+  w.WriteArray("covisibility/edges", d.covisibility_edges,
+               {static_cast<int64_t>(d.num_edges()), 2});
+  w.WriteArray("covisibility/weight", d.covisibility_weight);
+  WriteTrajectoryGroup(w, "prior", d.prior);
+  w.WriteJson("summary", d.summary);
+  w.Commit(provenance);
+}
+
+VisualMapData ReadVisualMap(const std::string& path) {
+  H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
+  VisualMapData d;
+  const auto cam = r.ReadArray<double>("camera");
+  JVL_CHECK(cam.size() == 6, path << ": camera must have 6 values, has " << cam.size());
+  d.camera = {cam[0], cam[1], cam[2], cam[3], static_cast<int>(cam[4]), static_cast<int>(cam[5])};
+  const nlohmann::json orb = r.ReadJson("orb");
+  d.scale_factor = orb.at("scale_factor").get<double>();
+  d.num_levels = orb.at("num_levels").get<int>();
+  d.keyframes = ReadTrajectoryGroup(r, "keyframes");
+  d.keypoint_keyframe = r.ReadArray<int32_t>("keypoints/keyframe");
+  d.keypoint_uv = r.ReadArray<float>("keypoints/uv", 2);
+  d.keypoint_octave = r.ReadArray<int32_t>("keypoints/octave");
+  d.keypoint_angle = r.ReadArray<float>("keypoints/angle");
+  d.keypoint_descriptor = r.ReadArray<uint8_t>("keypoints/descriptor", 32);
+  d.mappoint_position = r.ReadArray<double>("mappoints/position", 3);
+  d.mappoint_descriptor = r.ReadArray<uint8_t>("mappoints/descriptor", 32);
+  d.mappoint_normal = r.ReadArray<double>("mappoints/normal", 3);
+  d.observation_keyframe = r.ReadArray<int32_t>("observations/keyframe");
+  d.observation_keypoint = r.ReadArray<int32_t>("observations/keypoint");
+  d.observation_mappoint = r.ReadArray<int32_t>("observations/mappoint");
+  d.covisibility_edges = r.ReadArray<int32_t>("covisibility/edges", 2);
+  d.covisibility_weight = r.ReadArray<int32_t>("covisibility/weight");
+  d.prior = ReadTrajectoryGroup(r, "prior");
+  d.summary = r.ReadJson("summary");
+  d.Check(path);
+  return d;
+}
+
+std::vector<int64_t> ReadDirectionFrames(const std::string& path) {
+  H5Reader r(path, "directions", 1);
+  JVL_CHECK(r.Has("associations/frame"), path << ": no dataset associations/frame");
+  return r.ReadArray<int64_t>("associations/frame");
+}
+
+}  // namespace jvl::io

@@ -1,0 +1,66 @@
+// The "visual" artifact (schema "visual" v1, schemas/visual.schema.json): the visual map built by
+// visual_assoc from the prior poses (Sec. 4.1) and read by local and global optimisation:
+//
+//   camera double[6] (fx fy cx cy width height); attribute "orb" {scale_factor, num_levels};
+//   keyframes/{frames, poses}                  trajectory group: keyframe frame ids + prior poses
+//   keypoints/{keyframe int32[P], uv float[P,2], octave int32[P], angle float[P],
+//              descriptor uint8[P,32]}          all keypoints of all keyframes, grouped by keyframe
+//   mappoints/{position double[M,3], descriptor uint8[M,32], normal double[M,3]}
+//   observations/{keyframe int32[O], keypoint int32[O], mappoint int32[O]}  (row indices)
+//   covisibility/{edges int32[E,2], weight int32[E]}  (weight = shared map points)
+//   prior/{frames, poses, timestamps}          the full prior trajectory
+//   attribute "summary" (JSON)
+//
+// Also reads the frames with a direction association from a "directions" artifact.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "geometry/trajectory.h"
+#include "io/artifact.h"
+
+namespace jvl::io {
+
+inline constexpr const char* kVisualSchema = "visual";
+inline constexpr int kVisualSchemaVersion = 1;
+
+// Flat arrays laid out exactly as in the file (row-major).
+struct VisualMapData {
+  PinholeCamera camera;
+  double scale_factor = 1.2;  // ORB pyramid: keypoint sigma = scale_factor^octave px.
+  int num_levels = 8;
+  Trajectory keyframes;  // Keyframe frame ids and their prior world_from_cam0 poses.
+  std::vector<int32_t> keypoint_keyframe;
+  std::vector<float> keypoint_uv;  // P x 2
+  std::vector<int32_t> keypoint_octave;
+  std::vector<float> keypoint_angle;         // Degrees.
+  std::vector<uint8_t> keypoint_descriptor;  // P x 32
+  std::vector<double> mappoint_position;     // M x 3, world.
+  std::vector<uint8_t> mappoint_descriptor;  // M x 32
+  std::vector<double> mappoint_normal;       // M x 3, unit mean viewing direction.
+  std::vector<int32_t> observation_keyframe, observation_keypoint, observation_mappoint;
+  std::vector<int32_t> covisibility_edges;  // E x 2, keyframe rows, first < second.
+  std::vector<int32_t> covisibility_weight;
+  Trajectory prior;
+  nlohmann::json summary = nlohmann::json::object();
+
+  size_t num_keypoints() const { return keypoint_keyframe.size(); }
+  size_t num_mappoints() const { return mappoint_position.size() / 3; }
+  size_t num_observations() const { return observation_mappoint.size(); }
+  size_t num_edges() const { return covisibility_weight.size(); }
+  // Sizes agree and all indices are in range; throws naming `what`.
+  void Check(const std::string& what) const;
+};
+
+void WriteVisualMap(const std::string& path, const VisualMapData& data,
+                    const Provenance& provenance);
+VisualMapData ReadVisualMap(const std::string& path);
+
+// Frames that have a direction association (associations/frame of a "directions" v1 artifact).
+std::vector<int64_t> ReadDirectionFrames(const std::string& path);
+
+}  // namespace jvl::io

@@ -1,0 +1,147 @@
+#include "io/visual_io.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "core/check.h"
+
+namespace jvl::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Two keyframes with three keypoints each, two map points seen by both.
+VisualMapData MakeMap() {
+  VisualMapData d;
+  d.camera = {718.856, 718.856, 607.1928, 185.2157, 1226, 370};
+  d.keyframes.Append(3, Rigid3d());
+  d.keyframes.Append(5, Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1.5)));
+  d.prior = d.keyframes;
+  d.prior.Append(6, Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 2.5)));
+  for (int k = 0; k < 2; ++k) {
+    for (int i = 0; i < 3; ++i) {
+      d.keypoint_keyframe.push_back(k);
+      d.keypoint_uv.insert(d.keypoint_uv.end(), {100.5f + 10 * i, 50.25f + k});
+      d.keypoint_octave.push_back(i);
+      d.keypoint_angle.push_back(12.5f * i);
+      for (int b = 0; b < 32; ++b) d.keypoint_descriptor.push_back(static_cast<uint8_t>(b + i + k));
+    }
+  }
+  for (int m = 0; m < 2; ++m) {
+    d.mappoint_position.insert(d.mappoint_position.end(), {1.0 * m, -0.5, 10.0 + m});
+    for (int b = 0; b < 32; ++b) d.mappoint_descriptor.push_back(static_cast<uint8_t>(7 * b + m));
+    d.mappoint_normal.insert(d.mappoint_normal.end(), {0.0, 0.0, 1.0});
+    for (int k = 0; k < 2; ++k) {
+      d.observation_keyframe.push_back(k);
+      d.observation_keypoint.push_back(3 * k + m);
+      d.observation_mappoint.push_back(m);
+    }
+  }
+  d.covisibility_edges = {0, 1};
+  d.covisibility_weight = {2};
+  d.summary = {{"keyframes", 2}};
+  return d;
+}
+
+fs::path TempPath(const std::string& name) {
+  return fs::temp_directory_path() / ("jvl_visual_io_test_" + std::to_string(::getpid()) + name);
+}
+
+TEST(VisualIo, RoundTrip) {
+  const VisualMapData d = MakeMap();
+  const std::string path = TempPath("rt.h5").string();
+  WriteVisualMap(path, d, Provenance{});
+  const VisualMapData r = ReadVisualMap(path);
+  EXPECT_EQ(r.camera.fx, d.camera.fx);
+  EXPECT_EQ(r.camera.width, 1226);
+  EXPECT_EQ(r.keyframes.frames, d.keyframes.frames);
+  EXPECT_EQ(r.prior.frames, d.prior.frames);
+  EXPECT_NEAR(r.keyframes.world_from_cam[1].translation().z(), 1.5, 1e-15);
+  EXPECT_EQ(r.keypoint_keyframe, d.keypoint_keyframe);
+  EXPECT_EQ(r.keypoint_uv, d.keypoint_uv);
+  EXPECT_EQ(r.keypoint_octave, d.keypoint_octave);
+  EXPECT_EQ(r.keypoint_angle, d.keypoint_angle);
+  EXPECT_EQ(r.keypoint_descriptor, d.keypoint_descriptor);
+  EXPECT_EQ(r.mappoint_position, d.mappoint_position);
+  EXPECT_EQ(r.mappoint_descriptor, d.mappoint_descriptor);
+  EXPECT_EQ(r.observation_keypoint, d.observation_keypoint);
+  EXPECT_EQ(r.covisibility_edges, d.covisibility_edges);
+  EXPECT_EQ(r.covisibility_weight, d.covisibility_weight);
+  EXPECT_EQ(r.scale_factor, 1.2);
+  EXPECT_EQ(r.num_levels, 8);
+  EXPECT_EQ(r.summary.at("keyframes").get<int>(), 2);
+  fs::remove(path);
+}
+
+TEST(VisualIo, RejectsInconsistentIndices) {
+  VisualMapData d = MakeMap();
+  d.observation_keypoint[0] = 4;  // A keypoint of keyframe 1 for an observation in keyframe 0.
+  EXPECT_THROW(d.Check("map"), Error);
+  d = MakeMap();
+  d.observation_mappoint[1] = 9;
+  EXPECT_THROW(WriteVisualMap(TempPath("bad.h5").string(), d, Provenance{}), Error);
+  EXPECT_FALSE(fs::exists(TempPath("bad.h5")));
+}
+
+// Every dataset the schema lists exists with the declared rank and consistent symbolic sizes.
+TEST(VisualIo, WrittenFileMatchesSchema) {
+  const std::string path = TempPath("schema.h5").string();
+  WriteVisualMap(path, MakeMap(), Provenance{});
+  std::ifstream in(std::string(JVL_SOURCE_DIR) + "/schemas/visual.schema.json");
+  ASSERT_TRUE(in.good());
+  const nlohmann::json schema = nlohmann::json::parse(in);
+  const auto& h5 = schema.at("x-hdf5");
+  EXPECT_EQ(h5.at("schema"), kVisualSchema);
+  EXPECT_EQ(h5.at("schema_version"), kVisualSchemaVersion);
+  H5Reader reader(path, kVisualSchema, kVisualSchemaVersion);
+  std::map<std::string, int64_t> symbols;
+  for (const auto& [name, spec] : h5.at("datasets").items()) {
+    const bool required = spec.value("required", true);
+    if (!reader.Has(name)) {
+      EXPECT_FALSE(required) << name;
+      continue;
+    }
+    const std::vector<int64_t> dims = reader.Dims(name);
+    const auto& shape = spec.at("shape");
+    ASSERT_EQ(dims.size(), shape.size()) << name;
+    for (size_t i = 0; i < dims.size(); ++i) {
+      if (shape[i].is_number()) {
+        EXPECT_EQ(dims[i], shape[i].get<int64_t>()) << name;
+      } else {
+        const auto [it, inserted] = symbols.emplace(shape[i].get<std::string>(), dims[i]);
+        EXPECT_EQ(it->second, dims[i]) << name << " dimension " << shape[i];
+      }
+    }
+  }
+  EXPECT_EQ(symbols.at("K"), 2);
+  EXPECT_EQ(symbols.at("P"), 6);
+  EXPECT_EQ(symbols.at("O"), 4);
+  for (const auto& [name, spec] : h5.at("attributes").items()) {
+    if (name == "schema_version") continue;
+    EXPECT_NO_THROW(reader.ReadString(name)) << name;
+  }
+  fs::remove(path);
+}
+
+TEST(VisualIo, DirectionFramesNeedDirectionsSchema) {
+  const std::string path = TempPath("dir.h5").string();
+  {
+    H5Writer w(path, "directions", 1);
+    w.WriteArray<int64_t>("associations/frame", {2, 7, 11});
+    w.WriteArray<int32_t>("associations/cluster", {0, 0, 1});
+    w.Commit(Provenance{});
+  }
+  EXPECT_EQ(ReadDirectionFrames(path), (std::vector<int64_t>{2, 7, 11}));
+  const std::string other = TempPath("notdir.h5").string();
+  WriteVisualMap(other, MakeMap(), Provenance{});
+  EXPECT_THROW(ReadDirectionFrames(other), Error);
+  fs::remove(path);
+  fs::remove(other);
+}
+
+}  // namespace
+}  // namespace jvl::io

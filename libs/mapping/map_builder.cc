@@ -1,0 +1,226 @@
+#include "mapping/map_builder.h"
+
+#include <algorithm>
+#include <map>
+
+#include "core/check.h"
+#include "core/threads.h"
+#include "core/timer.h"
+
+namespace jvl::mapping {
+
+void VisualMapOptions::Check() const {
+  orb.Check();
+  projection.Check();
+  epipolar.Check();
+  triangulation.Check();
+  keyframe.Check();
+  JVL_CHECK(local_keyframes >= 1, "visual map: local_keyframes must be >= 1");
+  JVL_CHECK(triangulation_neighbors >= 1, "visual map: triangulation_neighbors must be >= 1");
+  JVL_CHECK(min_baseline_ratio >= 0, "visual map: min_baseline_ratio must be >= 0");
+  JVL_CHECK(min_view_cos >= -1 && min_view_cos <= 1, "visual map: min_view_cos in [-1, 1]");
+  JVL_CHECK(min_observations >= 2, "visual map: min_observations must be >= 2");
+  JVL_CHECK(cull_after_keyframes >= 1, "visual map: cull_after_keyframes must be >= 1");
+  JVL_CHECK(min_found_ratio >= 0 && min_found_ratio <= 1, "visual map: min_found_ratio in [0, 1]");
+  JVL_CHECK(max_final_chi2 > 0, "visual map: max_final_chi2 must be > 0");
+  JVL_CHECK(min_covisibility_weight >= 1, "visual map: min_covisibility_weight must be >= 1");
+}
+
+VisualMapBuilder::VisualMapBuilder(const PinholeCamera& camera, const VisualMapOptions& options)
+    : options_(options) {
+  options_.Check();
+  camera.Check();
+  JVL_CHECK(camera.width > 0 && camera.height > 0, "visual map: camera image size unknown");
+  map_.camera = camera;
+  map_.orb = options.orb;
+  map_.level_scales = vision::LevelScales(options.orb);
+}
+
+std::vector<int> VisualMapBuilder::LocalPoints() const {
+  std::vector<int> points;
+  const int n = static_cast<int>(map_.keyframes.size());
+  for (int k = std::max(0, n - options_.local_keyframes); k < n; ++k) {
+    for (int p : map_.keyframes[k].mappoint) {
+      if (p >= 0 && !map_.points[p].bad) points.push_back(p);
+    }
+  }
+  std::sort(points.begin(), points.end());
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  return points;
+}
+
+// Tracking with the prior pose: the local map points matched by projection. Returns, per keypoint,
+// the matched map point or -1.
+std::vector<int> VisualMapBuilder::Track(const vision::OrbFeatures& features,
+                                         const Rigid3d& cam_from_world, FrameReport* report) {
+  std::vector<int> predicted;
+  const auto projected =
+      PredictInView(map_, LocalPoints(), cam_from_world, options_.min_view_cos, &predicted);
+  const vision::KeypointGrid grid(features.keypoints, map_.camera.width, map_.camera.height);
+  const std::vector<int> match =
+      vision::MatchByProjection(projected, features, grid, map_.level_scales, options_.projection);
+  std::vector<int> keypoint_point(features.size(), -1);
+  for (size_t i = 0; i < match.size(); ++i) {
+    MapPoint& p = map_.points[predicted[i]];
+    ++p.visible;
+    if (match[i] < 0) continue;
+    ++p.found;
+    keypoint_point[match[i]] = predicted[i];
+    ++report->tracked;
+  }
+  report->candidates = static_cast<int>(projected.size());
+  return keypoint_point;
+}
+
+// Points of the reference keyframe (the one sharing most tracked points) seen by >= 3 keyframes
+// (2 while the map has at most 2 keyframes), as ORB-SLAM2's Tracking::NeedNewKeyFrame.
+int VisualMapBuilder::ReferenceTracked(const std::vector<int>& keypoint_point) const {
+  std::map<int, int> shared;
+  for (int p : keypoint_point) {
+    if (p < 0) continue;
+    for (const Observation& o : map_.points[p].observations) ++shared[o.keyframe];
+  }
+  int reference = static_cast<int>(map_.keyframes.size()) - 1, best = -1;
+  for (const auto& [k, n] : shared) {
+    if (n >= best) best = n, reference = k;  // Ties: the most recent keyframe.
+  }
+  if (reference < 0) return 0;
+  const int min_obs = map_.keyframes.size() <= 2 ? 2 : 3;
+  int count = 0;
+  for (int p : map_.keyframes[reference].mappoint) {
+    if (p >= 0 && static_cast<int>(map_.points[p].observations.size()) >= min_obs) ++count;
+  }
+  return count;
+}
+
+FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_cam,
+                                       vision::OrbFeatures features, bool has_direction) {
+  JVL_CHECK(frame > last_frame_ || first_,
+            "visual map: frame " << frame << " does not follow frame " << last_frame_);
+  const Timer timer;
+  FrameReport report;
+  report.frame = frame;
+  report.keypoints = static_cast<int>(features.size());
+  const Rigid3d cam_from_world = world_from_cam.Inverse();
+  ++frames_since_keyframe_;
+  std::vector<int> keypoint_point(features.size(), -1);
+  if (!first_) keypoint_point = Track(features, cam_from_world, &report);
+
+  KeyframeRuleInput input;
+  input.first_frame = first_;
+  input.frames_since_last_keyframe = frames_since_keyframe_;
+  input.tracked = report.tracked;
+  input.reference_tracked = first_ ? 0 : ReferenceTracked(keypoint_point);
+  input.has_direction = has_direction;
+  const KeyframeDecision decision = DecideKeyframe(input, options_.keyframe);
+  report.keyframe = decision.keyframe;
+  report.reason = decision.reason;
+  first_ = false;
+  if (decision.keyframe) {
+    Keyframe kf;
+    kf.frame = frame;
+    kf.world_from_cam = world_from_cam;
+    kf.cam_from_world = cam_from_world;
+    kf.mappoint.assign(features.size(), -1);
+    kf.features = std::move(features);
+    kf.has_direction = has_direction;
+    map_.keyframes.push_back(std::move(kf));
+    const int k = static_cast<int>(map_.keyframes.size()) - 1;
+    for (size_t i = 0; i < keypoint_point.size(); ++i) {
+      if (keypoint_point[i] < 0) continue;
+      AddObservation(&map_, keypoint_point[i], k, static_cast<int>(i));
+      UpdatePointGeometry(&map_, keypoint_point[i]);
+    }
+    const size_t before = map_.points.size();
+    report.new_points = CreateNewPoints(k);
+    std::vector<int> created;
+    for (size_t p = before; p < map_.points.size(); ++p) created.push_back(static_cast<int>(p));
+    report.fused = FusePoints(k, created);
+    report.culled = CullRecentPoints(k);
+    frames_since_keyframe_ = 0;
+  }
+  last_frame_ = frame;
+  report.ms = timer.ElapsedMs();
+  return report;
+}
+
+VisualMap VisualMapBuilder::Finish() {
+  for (size_t i = 0; i < map_.points.size(); ++i) {
+    MapPoint& p = map_.points[i];
+    if (p.bad) continue;
+    std::vector<vision::PointView> views;
+    for (const Observation& o : p.observations) {
+      const Keyframe& kf = map_.keyframes[o.keyframe];
+      const vision::OrbKeypoint& kp = kf.features.keypoints[o.keypoint];
+      views.push_back({kf.cam_from_world, kp.uv.cast<double>(), map_.level_scales[kp.octave]});
+    }
+    if (options_.refine_points && views.size() >= 2) {
+      p.position = vision::RefinePoint(map_.camera, views, p.position);
+    }
+    std::vector<Observation> kept;
+    for (size_t v = 0; v < views.size(); ++v) {
+      const double e2 = vision::SquaredReprojectionError(map_.camera, views[v].cam_from_world,
+                                                         p.position, views[v].uv);
+      const double s2 = views[v].level_scale * views[v].level_scale;
+      if (e2 <= options_.max_final_chi2 * s2) {
+        kept.push_back(p.observations[v]);
+      } else {
+        map_.keyframes[p.observations[v].keyframe].mappoint[p.observations[v].keypoint] = -1;
+      }
+    }
+    p.observations = kept;
+    if (p.observations.size() < 2) {
+      RemovePoint(&map_, static_cast<int>(i));
+    } else {
+      UpdatePointGeometry(&map_, static_cast<int>(i));
+    }
+  }
+  VisualMap out = std::move(map_);
+  map_ = VisualMap{};
+  return out;
+}
+
+VisualMapResult BuildVisualMap(const PinholeCamera& camera, const Trajectory& poses,
+                               const std::vector<int64_t>& direction_frames,
+                               const std::function<cv::Mat(int64_t)>& load_image,
+                               const VisualMapOptions& options, int threads,
+                               const std::function<void(const FrameReport&)>& on_frame) {
+  options.Check();
+  poses.Check("prior poses");
+  std::vector<int64_t> directions = direction_frames;
+  std::sort(directions.begin(), directions.end());
+  VisualMapResult result;
+  std::unique_ptr<VisualMapBuilder> builder;
+  const int64_t n = static_cast<int64_t>(poses.size());
+  const int64_t batch = std::max(1, threads) * 2;
+  for (int64_t start = 0; start < n; start += batch) {
+    const int64_t m = std::min(batch, n - start);
+    std::vector<vision::OrbFeatures> features(m);
+    std::vector<double> ms(m);
+    std::vector<cv::Size> sizes(m);
+    ParallelFor(m, threads, [&](int64_t i) {
+      const Timer t;
+      const cv::Mat image = load_image(poses.frames[start + i]);
+      sizes[i] = image.size();
+      features[i] = vision::ExtractOrb(image, options.orb);
+      ms[i] = t.ElapsedMs();
+    });
+    for (int64_t i = 0; i < m; ++i) {
+      if (!builder) {
+        PinholeCamera c = camera;
+        if (c.width <= 0 || c.height <= 0) c.width = sizes[i].width, c.height = sizes[i].height;
+        builder = std::make_unique<VisualMapBuilder>(c, options);
+      }
+      const int64_t frame = poses.frames[start + i];
+      const bool dir = std::binary_search(directions.begin(), directions.end(), frame);
+      result.frames.push_back(
+          builder->AddFrame(frame, poses.world_from_cam[start + i], std::move(features[i]), dir));
+      result.orb_ms.push_back(ms[i]);
+      if (on_frame) on_frame(result.frames.back());
+    }
+  }
+  if (builder) result.map = builder->Finish();
+  return result;
+}
+
+}  // namespace jvl::mapping

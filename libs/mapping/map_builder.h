@@ -1,0 +1,104 @@
+// Builds the visual map of Sec. 4.1 from ORB features and prior poses. Unlike ORB-SLAM2 there is
+// no motion-only bundle adjustment: each frame's pose is the prior, and it is used to
+//  1. match the points of the local map by projection (tracking),
+//  2. decide whether the frame is a keyframe (keyframe_rule.h, incl. direction frames),
+//  3. for keyframes: add the tracked observations, triangulate new points against the most recent
+//     keyframes under the epipolar constraint, fuse the new points into those keyframes, and
+//     cull recent points that are rarely found (ORB-SLAM2 LocalMapping, without local BA).
+// Finish() refines every point with the poses fixed (structure only) and drops outlier
+// observations.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "geometry/trajectory.h"
+#include "mapping/keyframe_rule.h"
+#include "mapping/visual_map.h"
+#include "vision/guided_matching.h"
+#include "vision/orb_features.h"
+#include "vision/triangulation.h"
+
+namespace jvl::mapping {
+
+struct VisualMapOptions {
+  vision::OrbOptions orb;
+  vision::ProjectionMatchOptions projection;
+  vision::EpipolarMatchOptions epipolar;
+  vision::TriangulationOptions triangulation;
+  KeyframeRuleOptions keyframe;
+  int local_keyframes = 10;          // Keyframes whose points are projected into a frame.
+  int triangulation_neighbors = 5;   // Recent keyframes matched with a new keyframe.
+  double min_baseline_ratio = 0.01;  // Baseline / median depth below which a pair is skipped.
+  double min_view_cos = 0.5;         // Points seen > 60 deg off their mean direction skip.
+  int min_observations = 3;          // Culling: keyframes needed once cull_after_keyframes passed.
+  int cull_after_keyframes = 2;      // Keyframes after creation before the observation test.
+  double min_found_ratio = 0.25;     // Culling: found / visible.
+  bool refine_points = true;         // Structure-only refinement in Finish().
+  double max_final_chi2 = 5.991;     // Observations beyond this (x level variance) are dropped.
+  int min_covisibility_weight = 15;  // Edges kept in the artifact (ORB-SLAM2 threshold).
+  void Check() const;
+};
+
+// What happened to one frame.
+struct FrameReport {
+  int64_t frame = 0;
+  int keypoints = 0;
+  int candidates = 0;  // Local map points predicted inside the frame.
+  int tracked = 0;     // Of those, matched.
+  bool keyframe = false;
+  KeyframeReason reason = KeyframeReason::kNone;
+  int new_points = 0;  // Triangulated (keyframes only).
+  int fused = 0;       // Extra observations of new points in neighbour keyframes.
+  int culled = 0;
+  double ms = 0;  // Association time (excluding ORB extraction).
+};
+
+class VisualMapBuilder {
+ public:
+  VisualMapBuilder(const PinholeCamera& camera, const VisualMapOptions& options);
+  // Frames must come in increasing frame order.
+  FrameReport AddFrame(int64_t frame, const Rigid3d& world_from_cam, vision::OrbFeatures features,
+                       bool has_direction);
+  // Refines points, drops outlier observations and returns the map (builder is then empty).
+  VisualMap Finish();
+  const VisualMap& map() const { return map_; }
+
+ private:
+  std::vector<int> LocalPoints() const;
+  std::vector<int> Track(const vision::OrbFeatures& features, const Rigid3d& cam_from_world,
+                         FrameReport* report);
+  int ReferenceTracked(const std::vector<int>& match) const;
+  int CreateNewPoints(int keyframe);                                 // map_points.cc
+  int FusePoints(int keyframe, const std::vector<int>& new_points);  // map_points.cc
+  int CullRecentPoints(int keyframe);                                // map_points.cc
+  std::vector<int> NeighbourKeyframes(int keyframe) const;           // map_points.cc
+
+  VisualMapOptions options_;
+  VisualMap map_;
+  std::vector<int> recent_points_;  // Created within the last keyframes; subject to culling.
+  int64_t last_frame_ = -1;
+  int frames_since_keyframe_ = 0;
+  bool first_ = true;
+};
+
+// Runs the builder over the frames of `poses`: images are loaded and ORB features extracted in
+// parallel batches (threads), association is sequential. `load_image(frame)` returns the image,
+// `direction_frames` lists frames with a direction association (may be empty), `on_frame` (may be
+// empty) is called after each frame.
+struct VisualMapResult {
+  VisualMap map;
+  std::vector<FrameReport> frames;
+  std::vector<double> orb_ms;  // Per frame ORB extraction time.
+};
+VisualMapResult BuildVisualMap(const PinholeCamera& camera, const Trajectory& poses,
+                               const std::vector<int64_t>& direction_frames,
+                               const std::function<cv::Mat(int64_t)>& load_image,
+                               const VisualMapOptions& options, int threads,
+                               const std::function<void(const FrameReport&)>& on_frame = {});
+
+}  // namespace jvl::mapping

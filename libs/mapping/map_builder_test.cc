@@ -1,0 +1,149 @@
+#include "mapping/map_builder.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "core/check.h"
+#include "mapping/visual_map.h"
+
+namespace jvl::mapping {
+namespace {
+
+PinholeCamera KittiCamera() { return {718.856, 718.856, 607.1928, 185.2157, 1226, 370}; }
+
+// A road corridor (two walls and the ground) seen by a camera driving forward at 1.4 m/frame.
+// Each frame's features are the noisy projections of the visible points (descriptor with a few
+// flipped bits, octave from the distance) plus confusers with copied descriptors elsewhere.
+class Corridor {
+ public:
+  explicit Corridor(int frames) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> along(0, 1.4 * frames + 80), wall_y(-4, 1.6),
+        ground_x(-7, 7), ref(30, 90);
+    for (int i = 0; i < 6000; ++i) {
+      const int kind = i % 3;
+      const double z = along(rng);
+      points_.push_back(kind == 0   ? Eigen::Vector3d(-7.5, wall_y(rng), z)
+                        : kind == 1 ? Eigen::Vector3d(7.5, wall_y(rng), z)
+                                    : Eigen::Vector3d(ground_x(rng), 1.65, z));
+      vision::Descriptor d;
+      for (auto& b : d) b = static_cast<uint8_t>(rng() & 0xff);
+      descriptors_.push_back(d);
+      reference_distance_.push_back(ref(rng));
+    }
+    for (int f = 0; f < frames; ++f) {
+      poses_.Append(f, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.004 * f, 0)),
+                               Eigen::Vector3d(0.02 * f, 0, 1.4 * f)));
+    }
+  }
+  const Trajectory& poses() const { return poses_; }
+  const Eigen::Vector3d& point(int i) const { return points_[i]; }
+
+  vision::OrbFeatures View(int frame, std::vector<int>* truth) const {
+    const PinholeCamera cam = KittiCamera();
+    std::mt19937 rng(100 + frame);
+    std::normal_distribution<double> noise(0.0, 0.3);
+    std::uniform_real_distribution<float> u(0, 1226), v(0, 370);
+    const Rigid3d cam_from_world = poses_.world_from_cam[frame].Inverse();
+    vision::OrbFeatures f;
+    truth->clear();
+    auto add = [&](const Eigen::Vector2f& uv, int octave, const vision::Descriptor& d, int id) {
+      f.keypoints.push_back({uv, octave, 10.f, 20.f});
+      f.descriptors.push_back(d);
+      truth->push_back(id);
+    };
+    for (size_t i = 0; i < points_.size(); ++i) {
+      const Eigen::Vector3d p = cam_from_world * points_[i];
+      if (p.z() < 1.0) continue;
+      const int octave = std::clamp(
+          static_cast<int>(
+              std::floor(std::log(reference_distance_[i] / p.norm()) / std::log(1.2) + 0.5)),
+          0, 7);
+      const double s = std::pow(1.2, octave);
+      const Eigen::Vector2d uv = cam.Project(p) + s * Eigen::Vector2d(noise(rng), noise(rng));
+      if (!cam.InImage(uv, 20)) continue;
+      vision::Descriptor d = descriptors_[i];
+      for (int k = 0; k < 4; ++k) d[rng() % 32] ^= static_cast<uint8_t>(1u << (rng() % 8));
+      add(uv.cast<float>(), octave, d, static_cast<int>(i));
+      if (i % 4 == 0) add(Eigen::Vector2f(u(rng), v(rng)), octave, d, -1);  // Confuser.
+    }
+    return f;
+  }
+
+ private:
+  std::vector<Eigen::Vector3d> points_;
+  std::vector<vision::Descriptor> descriptors_;
+  std::vector<double> reference_distance_;
+  Trajectory poses_;
+};
+
+TEST(VisualMapBuilder, SyntheticCorridorWithKnownPoses) {
+  const Corridor scene(30);
+  VisualMapOptions options;
+  options.keyframe.min_frames_between = 4;
+  VisualMapBuilder builder(KittiCamera(), options);
+  std::vector<std::vector<int>> truth(30);
+  std::vector<FrameReport> reports;
+  const std::vector<int64_t> direction_frames = {9, 10};
+  for (int f = 0; f < 30; ++f) {
+    const bool dir = std::count(direction_frames.begin(), direction_frames.end(), f) > 0;
+    reports.push_back(
+        builder.AddFrame(f, scene.poses().world_from_cam[f], scene.View(f, &truth[f]), dir));
+  }
+  // Direction frames are keyframes although consecutive (C2 with 4 frames would forbid it).
+  EXPECT_TRUE(reports[9].keyframe);
+  EXPECT_TRUE(reports[10].keyframe);
+  EXPECT_EQ(reports[10].reason, KeyframeReason::kDirection);
+  EXPECT_FALSE(reports[11].keyframe);
+
+  const VisualMap map = builder.Finish();
+  int good = 0, wrong = 0;
+  std::vector<double> error_near;
+  for (const MapPoint& p : map.points) {
+    if (p.bad) continue;
+    ++good;
+    std::vector<int> ids;
+    for (const Observation& o : p.observations) {
+      ids.push_back(truth[map.keyframes[o.keyframe].frame][o.keypoint]);
+    }
+    const bool consistent = ids.front() >= 0 && std::all_of(ids.begin(), ids.end(), [&](int id) {
+                              return id == ids.front();
+                            });
+    if (!consistent) {
+      ++wrong;
+      continue;
+    }
+    const Keyframe& first = map.keyframes[p.observations.front().keyframe];
+    if ((first.cam_from_world * p.position).z() < 30) {
+      error_near.push_back((p.position - scene.point(ids.front())).norm());
+    }
+  }
+  ASSERT_GT(good, 1000);
+  EXPECT_LT(wrong, 0.02 * good);
+  std::sort(error_near.begin(), error_near.end());
+  ASSERT_GT(error_near.size(), 500u);
+  // Median 3D error within 30 m; keypoint noise is 0.3 px x level scale (up to 1.1 px).
+  EXPECT_LT(error_near[error_near.size() / 2], 0.10);
+
+  const io::VisualMapData data = ExportVisualMap(map, scene.poses(), 15);
+  data.Check("synthetic");
+  const VisualMapStats stats = ComputeStats(data);
+  EXPECT_LT(stats.median_reprojection_px, 1.0);
+  EXPECT_GE(stats.min_points_per_keyframe, 100);
+  EXPECT_GT(stats.edges, 0);
+  for (int w : data.covisibility_weight) EXPECT_GE(w, 15);
+}
+
+TEST(VisualMapBuilder, RejectsFramesOutOfOrder) {
+  const Corridor scene(3);
+  VisualMapBuilder builder(KittiCamera(), VisualMapOptions());
+  std::vector<int> truth;
+  builder.AddFrame(1, scene.poses().world_from_cam[1], scene.View(1, &truth), false);
+  EXPECT_THROW(builder.AddFrame(0, scene.poses().world_from_cam[0], scene.View(0, &truth), false),
+               Error);
+}
+
+}  // namespace
+}  // namespace jvl::mapping

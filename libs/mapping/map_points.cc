@@ -1,0 +1,145 @@
+// New map points of a keyframe (ORB-SLAM2 LocalMapping::CreateNewMapPoints, SearchInNeighbors
+// and MapPointCulling), with the prior poses in place of the optimised ones.
+#include <algorithm>
+
+#include "mapping/map_builder.h"
+
+namespace jvl::mapping {
+namespace {
+
+// Median depth of the points a keyframe observes (for the baseline test), 0 if it has none.
+double MedianDepth(const VisualMap& map, const Keyframe& kf) {
+  std::vector<double> depth;
+  for (int p : kf.mappoint) {
+    if (p >= 0 && !map.points[p].bad)
+      depth.push_back((kf.cam_from_world * map.points[p].position).z());
+  }
+  if (depth.empty()) return 0;
+  std::nth_element(depth.begin(), depth.begin() + depth.size() / 2, depth.end());
+  return depth[depth.size() / 2];
+}
+
+std::vector<bool> Used(const Keyframe& kf) {
+  std::vector<bool> used(kf.mappoint.size());
+  for (size_t i = 0; i < used.size(); ++i) used[i] = kf.mappoint[i] >= 0;
+  return used;
+}
+
+}  // namespace
+
+// The previous keyframes, most recent first. For a camera moving along a road these are the
+// keyframes with the largest overlap, which ORB-SLAM2 finds through the covisibility graph.
+std::vector<int> VisualMapBuilder::NeighbourKeyframes(int keyframe) const {
+  std::vector<int> out;
+  for (int k = keyframe - 1; k >= 0 && static_cast<int>(out.size()) < options_.local_keyframes;
+       --k) {
+    out.push_back(k);
+  }
+  return out;
+}
+
+int VisualMapBuilder::CreateNewPoints(int keyframe) {
+  const std::vector<int> neighbours = NeighbourKeyframes(keyframe);
+  int created = 0;
+  for (size_t n = 0;
+       n < neighbours.size() && static_cast<int>(n) < options_.triangulation_neighbors; ++n) {
+    const Keyframe& kf = map_.keyframes[keyframe];
+    const Keyframe& nb = map_.keyframes[neighbours[n]];
+    // Too short a baseline for the scene depth gives no usable parallax (ORB-SLAM2, monocular).
+    const double baseline =
+        (kf.world_from_cam.translation() - nb.world_from_cam.translation()).norm();
+    const double depth = MedianDepth(map_, nb);
+    if (depth > 0 && baseline / depth < options_.min_baseline_ratio) continue;
+    const auto pairs =
+        vision::MatchEpipolar(map_.camera, kf.features, kf.cam_from_world, Used(kf), nb.features,
+                              nb.cam_from_world, Used(nb), map_.level_scales, options_.epipolar);
+    for (const auto& [i, j] : pairs) {
+      const vision::OrbKeypoint& a = kf.features.keypoints[i];
+      const vision::OrbKeypoint& b = nb.features.keypoints[j];
+      const vision::TriangulationResult t = vision::TriangulateTwoViews(
+          map_.camera, {kf.cam_from_world, a.uv.cast<double>(), map_.level_scales[a.octave]},
+          {nb.cam_from_world, b.uv.cast<double>(), map_.level_scales[b.octave]},
+          options_.triangulation);
+      if (t.status != vision::TriangulationStatus::kOk) continue;
+      MapPoint point;
+      point.position = t.position;
+      point.created_keyframe = keyframe;
+      map_.points.push_back(point);
+      const int p = static_cast<int>(map_.points.size()) - 1;
+      AddObservation(&map_, p, neighbours[n], j);
+      AddObservation(&map_, p, keyframe, i);
+      UpdatePointGeometry(&map_, p);
+      recent_points_.push_back(p);
+      ++created;
+    }
+  }
+  return created;
+}
+
+// Adds observations of the new points in the other local keyframes (the "fuse" step of
+// ORB-SLAM2 restricted to keypoints without a map point).
+int VisualMapBuilder::FusePoints(int keyframe, const std::vector<int>& new_points) {
+  int fused = 0;
+  std::vector<int> touched;
+  for (int k : NeighbourKeyframes(keyframe)) {
+    Keyframe& nb = map_.keyframes[k];
+    std::vector<int> candidates;
+    for (int p : new_points) {
+      const auto& obs = map_.points[p].observations;
+      const bool seen = std::any_of(obs.begin(), obs.end(),
+                                    [k](const Observation& o) { return o.keyframe == k; });
+      if (!seen && !map_.points[p].bad) candidates.push_back(p);
+    }
+    std::vector<int> predicted;
+    const auto projected =
+        PredictInView(map_, candidates, nb.cam_from_world, options_.min_view_cos, &predicted);
+    if (projected.empty()) continue;
+    const vision::KeypointGrid grid(nb.features.keypoints, map_.camera.width, map_.camera.height);
+    const std::vector<int> match = vision::MatchByProjection(
+        projected, nb.features, grid, map_.level_scales, options_.projection, Used(nb));
+    for (size_t i = 0; i < match.size(); ++i) {
+      if (match[i] < 0) continue;
+      const int p = predicted[i];
+      const vision::OrbKeypoint& kp = nb.features.keypoints[match[i]];
+      const double s = map_.level_scales[kp.octave];
+      if (vision::SquaredReprojectionError(map_.camera, nb.cam_from_world, map_.points[p].position,
+                                           kp.uv.cast<double>()) >
+          options_.triangulation.max_reprojection_chi2 * s * s) {
+        continue;
+      }
+      AddObservation(&map_, p, k, match[i]);
+      touched.push_back(p);
+      ++fused;
+    }
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  for (int p : touched) UpdatePointGeometry(&map_, p);
+  return fused;
+}
+
+// ORB-SLAM2 MapPointCulling: a recent point must be found in >= 25 % of the frames predicting it
+// and, once cull_after_keyframes keyframes have passed, be observed by >= min_observations
+// keyframes; a point that survives one more keyframe is kept for good.
+int VisualMapBuilder::CullRecentPoints(int keyframe) {
+  int culled = 0;
+  std::vector<int> still_recent;
+  for (int p : recent_points_) {
+    MapPoint& point = map_.points[p];
+    if (point.bad) continue;
+    const int age = keyframe - point.created_keyframe;
+    const bool rarely_found = point.found < options_.min_found_ratio * point.visible;
+    const bool few_views = age >= options_.cull_after_keyframes &&
+                           static_cast<int>(point.observations.size()) < options_.min_observations;
+    if (rarely_found || few_views) {
+      RemovePoint(&map_, p);
+      ++culled;
+    } else if (age <= options_.cull_after_keyframes) {
+      still_recent.push_back(p);
+    }
+  }
+  recent_points_ = std::move(still_recent);
+  return culled;
+}
+
+}  // namespace jvl::mapping

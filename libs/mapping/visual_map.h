@@ -1,0 +1,94 @@
+// The visual map while it is built: keyframes with their ORB features and prior poses, map points
+// with their observations (ORB-SLAM2's map, without the pose optimisation), and its export to the
+// flat "visual" artifact layout.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "geometry/rigid3.h"
+#include "geometry/trajectory.h"
+#include "io/visual_io.h"
+#include "vision/guided_matching.h"
+#include "vision/orb_features.h"
+
+namespace jvl::mapping {
+
+struct Observation {
+  int keyframe = -1;
+  int keypoint = -1;
+};
+
+struct MapPoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // World.
+  vision::Descriptor descriptor{};  // Most representative observation (min median distance).
+  float reference_angle = 0;        // Keypoint angle of that observation (orientation check).
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // Mean unit viewing direction.
+  double min_distance = 0, max_distance = 0;          // Scale invariance range (m).
+  std::vector<Observation> observations;              // Ordered by keyframe.
+  int created_keyframe = -1;
+  int visible = 1, found = 1;  // Times predicted inside a frame / matched there (culling).
+  bool bad = false;
+};
+
+struct Keyframe {
+  int64_t frame = 0;
+  Rigid3d world_from_cam;
+  Rigid3d cam_from_world;
+  vision::OrbFeatures features;
+  std::vector<int> mappoint;  // Per keypoint: map point index or -1.
+  bool has_direction = false;
+};
+
+struct VisualMap {
+  PinholeCamera camera;
+  vision::OrbOptions orb;
+  std::vector<double> level_scales;
+  std::vector<Keyframe> keyframes;
+  std::vector<MapPoint> points;
+};
+
+// Recomputes the normal, scale invariance range and representative descriptor of a point from
+// its observations (ORB-SLAM2 MapPoint::UpdateNormalAndDepth, ComputeDistinctiveDescriptors).
+void UpdatePointGeometry(VisualMap* map, int point);
+
+// Adds an observation of `point` by keypoint `keypoint` of keyframe `keyframe`.
+void AddObservation(VisualMap* map, int point, int keyframe, int keypoint);
+
+// Marks a point bad and detaches it from its keyframes.
+void RemovePoint(VisualMap* map, int point);
+
+// Predicted pyramid level of a point seen at distance `distance` (ORB-SLAM2 PredictScale).
+int PredictOctave(const MapPoint& point, double distance, const VisualMap& map);
+
+// Projects `points` into a view (ORB-SLAM2 Frame::isInFrustum): in front of the camera, inside
+// the image, within 0.8-1.2 x the scale invariance range and at most acos(min_view_cos) off the
+// mean viewing direction. Returns the predictions; predicted[i] is the map point of row i.
+std::vector<vision::ProjectedPoint> PredictInView(const VisualMap& map,
+                                                  const std::vector<int>& points,
+                                                  const Rigid3d& cam_from_world,
+                                                  double min_view_cos, std::vector<int>* predicted);
+
+struct CovisibilityEdge {
+  int a = 0, b = 0;  // Keyframe rows, a < b.
+  int weight = 0;    // Map points observed by both.
+};
+// All keyframe pairs sharing at least min_weight map points, ordered by (a, b).
+std::vector<CovisibilityEdge> Covisibility(const VisualMap& map, int min_weight);
+
+// Flat artifact layout: good points only (renumbered), all keypoints of every keyframe,
+// observations ordered by (keyframe, keypoint), covisibility edges with weight >= min_weight.
+io::VisualMapData ExportVisualMap(const VisualMap& map, const Trajectory& prior, int min_weight);
+
+// Figures reported by visual_assoc and checked by the tests.
+struct VisualMapStats {
+  int keyframes = 0, mappoints = 0, observations = 0, edges = 0;
+  double median_points_per_keyframe = 0, min_points_per_keyframe = 0;
+  double mean_observations_per_point = 0;
+  double median_reprojection_px = 0, p90_reprojection_px = 0;
+};
+VisualMapStats ComputeStats(const io::VisualMapData& data);
+
+}  // namespace jvl::mapping

@@ -1,0 +1,51 @@
+// ORB features spread over the image, in the manner of ORB-SLAM2 (Mur-Artal & Tardos 2017):
+// an 8-level pyramid with scale 1.2, FAST corners detected per grid cell (threshold 20, 7 where a
+// cell has none), the strongest corners kept per cell round-robin so that every cell contributes,
+// orientation by the intensity centroid and rotated BRIEF descriptors computed with cv::ORB.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace jvl::vision {
+
+using Descriptor = std::array<uint8_t, 32>;
+
+// Hamming distance of two 256-bit descriptors.
+int HammingDistance(const Descriptor& a, const Descriptor& b);
+
+struct OrbOptions {
+  int num_features = 2000;     // Total over all levels (ORB-SLAM2 KITTI setting).
+  int num_levels = 8;          // Pyramid levels.
+  double scale_factor = 1.2;   // Scale between consecutive levels.
+  int fast_threshold = 20;     // FAST threshold tried first in every cell.
+  int fast_min_threshold = 7;  // Retried in cells where the first threshold finds nothing.
+  int cell_size = 30;          // Grid cell size in pixels of each level.
+  int edge_threshold = 19;     // Border (level pixels) without features (BRIEF patch 31).
+  void Check() const;
+};
+
+struct OrbKeypoint {
+  Eigen::Vector2f uv;  // Level-0 pixel coordinates.
+  int octave = 0;      // Pyramid level.
+  float angle = 0;     // Orientation in degrees [0, 360), as cv::KeyPoint.
+  float response = 0;  // FAST score.
+};
+
+struct OrbFeatures {
+  std::vector<OrbKeypoint> keypoints;
+  std::vector<Descriptor> descriptors;  // Same length as keypoints.
+  size_t size() const { return keypoints.size(); }
+};
+
+// Scale of each level: scale_factor^level (level 0 = 1).
+std::vector<double> LevelScales(const OrbOptions& options);
+
+// Detects and describes ORB features in a greyscale (or colour, converted) image. Deterministic.
+// Keypoints are ordered by octave, then by row-major grid cell, then by decreasing response.
+OrbFeatures ExtractOrb(const cv::Mat& image, const OrbOptions& options);
+
+}  // namespace jvl::vision

@@ -1,0 +1,64 @@
+// visual_assoc: ORB features, map points and keyframes from prior poses (Sec. 4.1).
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "app/tool.h"
+#include "cli_options.h"
+#include "core/check.h"
+#include "core/progress.h"
+#include "io/dataset.h"
+#include "io/trajectory_io.h"
+#include "io/visual_io.h"
+#include "mapping/map_builder.h"
+#include "mapping/summary.h"
+
+int main(int argc, char** argv) {
+  using namespace jvl;
+  app::Tool tool("visual_assoc",
+                 "Build the visual map (ORB keyframes, map points, observations, covisibility) "
+                 "from prior poses.");
+  std::string dataset_dir, format = "auto", frames = ":", prior_path, directions_path, output;
+  mapping::VisualMapOptions options;
+  auto& cli = tool.cli();
+  cli.add_option("--dataset", dataset_dir, "Dataset folder (KITTI sequence)")->required();
+  cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
+  cli.add_option("--prior", prior_path, "Prior trajectory (.h5, KITTI or TUM)")->required();
+  cli.add_option("--directions", directions_path, "directions.h5: its frames become keyframes");
+  cli.add_option("-o,--output", output, "Output visual.h5")->required();
+  tools::AddVisualMapFlags(cli, &options);
+  return tool.Run(argc, argv, [&] {
+    options.Check();
+    auto dataset =
+        io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
+    tool.SetDatasetId(dataset->id());
+    for (const auto& f : dataset->KeyFiles()) tool.AddInput(f);
+    const Trajectory prior = io::ReadTrajectory(prior_path);
+    tool.AddInput(prior_path);
+    const Trajectory poses = mapping::SelectPriorPoses(prior, dataset->frames(), prior_path);
+    std::vector<int64_t> direction_frames;
+    if (!directions_path.empty()) {
+      direction_frames = io::ReadDirectionFrames(directions_path);
+      tool.AddInput(directions_path);
+    }
+    Progress progress("visual_assoc", static_cast<int64_t>(poses.size()), !tool.quiet());
+    const mapping::VisualMapResult result = mapping::BuildVisualMap(
+        dataset->calibration().Camera(0), poses, direction_frames,
+        [&](int64_t f) { return dataset->LoadImage(f, 0); }, options, tool.threads(),
+        [&](const mapping::FrameReport& r) {
+          spdlog::debug(
+              "frame {}: {} keypoints, tracked {}/{}, keyframe {} ({}), new {}, fused {}, "
+              "culled {}, {:.1f} ms",
+              r.frame, r.keypoints, r.tracked, r.candidates, r.keyframe,
+              mapping::ToString(r.reason), r.new_points, r.fused, r.culled, r.ms);
+          progress.Tick();
+        });
+    io::VisualMapData data =
+        mapping::ExportVisualMap(result.map, prior, options.min_covisibility_weight);
+    data.summary = mapping::Summarize(result, mapping::ComputeStats(data));
+    io::WriteVisualMap(output, data, tool.MakeProvenance());
+    std::printf("%s\n", mapping::FormatSummary(data.summary).c_str());
+    spdlog::info("visual_assoc: wrote {}", output);
+  });
+}
