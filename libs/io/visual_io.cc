@@ -106,10 +106,4 @@ VisualMapData ReadVisualMap(const std::string& path) {
   return d;
 }
 
-std::vector<int64_t> ReadDirectionFrames(const std::string& path) {
-  H5Reader r(path, "directions", 1);
-  JVL_CHECK(r.Has("associations/frame"), path << ": no dataset associations/frame");
-  return r.ReadArray<int64_t>("associations/frame");
-}
-
 }  // namespace jvl::io

@@ -11,7 +11,6 @@
 //   prior/{frames, poses, timestamps}          the full prior trajectory
 //   attribute "summary" (JSON)
 //
-// Also reads the frames with a direction association from a "directions" artifact.
 #pragma once
 
 #include <cstdint>
@@ -60,7 +59,5 @@ void WriteVisualMap(const std::string& path, const VisualMapData& data,
                     const Provenance& provenance);
 VisualMapData ReadVisualMap(const std::string& path);
 
-// Frames that have a direction association (associations/frame of a "directions" v1 artifact).
-std::vector<int64_t> ReadDirectionFrames(const std::string& path);
 
 }  // namespace jvl::io

@@ -9,6 +9,7 @@
 #include "core/progress.h"
 #include "io/dataset.h"
 #include "io/trajectory_io.h"
+#include "io/directions_io.h"
 #include "io/visual_io.h"
 #include "mapping/map_builder.h"
 #include "mapping/summary.h"
@@ -39,7 +40,8 @@ int main(int argc, char** argv) {
     const Trajectory poses = mapping::SelectPriorPoses(prior, dataset->frames(), prior_path);
     std::vector<int64_t> direction_frames;
     if (!directions_path.empty()) {
-      direction_frames = io::ReadDirectionFrames(directions_path);
+      for (const auto& a : io::ReadDirectionsArtifact(directions_path).associations)
+        direction_frames.push_back(a.frame);
       tool.AddInput(directions_path);
     }
     Progress progress("visual_assoc", static_cast<int64_t>(poses.size()), !tool.quiet());
