@@ -52,6 +52,7 @@ SequenceEval EvaluateSequence(const PoseSeries& gt_in, const PoseSeries& est_in,
   if (options.alignment == Alignment::kOrigin || options.origin_first) {
     ToOrigin(a, &gt, &est);
     r.origin_frame = gt.frames[a.gt_row.front()];
+    r.world_from_origin = gt_in.poses[a.gt_row.front()];
   }
   if (options.alignment == Alignment::kSE3 || options.alignment == Alignment::kSim3) {
     std::vector<Eigen::Vector3d> est_xyz, gt_xyz;

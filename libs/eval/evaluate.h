@@ -33,8 +33,11 @@ struct SequenceEval {
   std::vector<int64_t> est_unmatched_frames;  // Estimates without ground truth.
   std::vector<int64_t> gt_missing_frames;     // Ground-truth frames without estimate (in span).
   int64_t origin_frame = -1;                  // Ground-truth frame used as origin, or -1.
-  Similarity alignment;                       // Applied to the (origin-relative) estimate.
-  PairedPoses paired;                         // After alignment; all ground-truth rows.
+  // The ground-truth pose at origin_frame (identity without one): maps `paired` back into the
+  // ground truth's own world frame, so that plots of several estimates share one frame.
+  Eigen::Matrix4d world_from_origin = Eigen::Matrix4d::Identity();
+  Similarity alignment;  // Applied to the (origin-relative) estimate.
+  PairedPoses paired;    // After alignment; all ground-truth rows.
   ApeResult ape;
   RpeResult rpe;
   KittiResult kitti;

@@ -152,10 +152,13 @@ nlohmann::json PlotData(const std::vector<EstimateEval>& estimates, const EvalOp
     for (const SequenceEval& s : e.sequences) {
       nlohmann::json js = {{"name", s.name}};
       nlohmann::json gt = nlohmann::json::array(), est = nlohmann::json::array();
+      auto xyz = [&s](const Eigen::Matrix4d& pose) {
+        const Eigen::Vector4d p = s.world_from_origin * pose.col(3);
+        return nlohmann::json::array({p.x(), p.y(), p.z()});
+      };
       for (size_t i = 0; i < s.paired.size(); ++i) {
-        gt.push_back({s.paired.gt[i](0, 3), s.paired.gt[i](1, 3), s.paired.gt[i](2, 3)});
-        if (!s.paired.has_est[i]) continue;
-        est.push_back({s.paired.est[i](0, 3), s.paired.est[i](1, 3), s.paired.est[i](2, 3)});
+        gt.push_back(xyz(s.paired.gt[i]));
+        if (s.paired.has_est[i]) est.push_back(xyz(s.paired.est[i]));
       }
       js["gt_xyz"] = std::move(gt);
       js["est_xyz"] = std::move(est);

@@ -6,8 +6,14 @@ definitions in docs/evaluate.md (KITTI devkit segment metric, Umeyama 1991, kitt
 "7dof" procedure for sim3 + origin-first). Regenerate (deterministic) with:
 
     python3 tests/eval/make_golden.py tests/eval/data
+
+With a frame count it writes only the two trajectories of that length (no expected numbers),
+e.g. the 4541-pose input of the benchmark in docs/evaluate.md:
+
+    python3 tests/eval/make_golden.py /tmp/long 4541
 """
 import json
+import os
 import sys
 
 import numpy as np
@@ -181,6 +187,12 @@ CASES = [
 
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "tests/eval/data"
+    os.makedirs(out, exist_ok=True)
+    if len(sys.argv) > 2:
+        gt, est = make_trajectories(n=int(sys.argv[2]))
+        write_kitti(out + "/gt.txt", gt, indexed=False, fmt="%.9e")
+        write_kitti(out + "/est.txt", est, indexed=True, fmt="%.7e")
+        return
     gt, est = make_trajectories()
     # Limited precision like real KITTI files, so rotation blocks are orthonormal only to ~1e-7.
     write_kitti(out + "/gt.txt", gt, indexed=False, fmt="%.9e")
