@@ -8,7 +8,7 @@ packages=(
   build-essential cmake pkg-config git
   libeigen3-dev libopencv-dev libpcl-dev libceres-dev
   libcli11-dev nlohmann-json3-dev libhdf5-dev libspdlog-dev libfmt-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libembree-dev
   python3 python3-matplotlib python3-numpy
 )
 
