@@ -220,7 +220,7 @@ Drive PlanDrive(const Route& route, const DriveOptions& options) {
   while (s < route.length()) {
     double a = (allowed(s) - v) / 0.5;
     a = std::clamp(a, -options.max_decel * 1.5, options.max_accel);
-    if (!stop_done && v < 0.05 && options.stop_at_s - s < 0.5) {
+    if (!stop_done && options.stop_at_s - s < 0.2) {
       a = 0;
       v = 0;
       stopped += d.dt;

@@ -87,7 +87,7 @@ void PlaceBuildings(Scene& scene, Rng& rng) {
         bool ok = len >= 6;
         for (const auto& c : corners) ok = ok && scene.route.Distance(c) > clear - 0.3;
         for (const Building& o : scene.buildings) {
-          ok = ok && !RectanglesOverlap(corners, o.Corners(), 0.5);
+          ok = ok && !RectanglesOverlap(corners, o.Corners(), -0.1);
         }
         if (ok) {
           const Eigen::Vector2d ground = b.center;

@@ -9,10 +9,9 @@
 #include "core/check.h"
 #include "core/progress.h"
 #include "core/timer.h"
-#include "io/kitti.h"
-#include "io/sim_io.h"
 #include "sim/describe.h"
 #include "sim/sequence.h"
+#include "sim/write_sequence.h"
 
 int main(int argc, char** argv) {
   jvl::app::Tool tool("sim_sequence", "Generate a synthetic KITTI-layout driving sequence.");
@@ -51,34 +50,16 @@ int main(int argc, char** argv) {
     spdlog::info("world: {} triangles, {} buildings, {} frames, built in {:.2f} s",
                  world->scene.mesh.triangles.size(), world->scene.buildings.size(),
                  world->ground_truth.size(), timer.ElapsedSeconds());
-    const jvl::io::KittiLayout layout{output, sequence};
-    jvl::io::WriteKittiSequenceMetadata(layout, opt.calibration, world->ground_truth);
-    std::vector<std::vector<jvl::io::GtVpRow>> vps(world->ground_truth.size());
-    jvl::Progress progress("sim_sequence", static_cast<int64_t>(vps.size()), !tool.quiet());
-    jvl::Timer frames_timer;
-    jvl::sim::GenerateSequence(*world, tool.threads(), [&](jvl::sim::SimFrame&& f) {
-      if (opt.simulate_scans) jvl::io::WriteVelodyneBin(layout.ScanPath(f.frame), f.scan);
-      if (opt.render_images) jvl::io::WriteImage(layout.ImagePath(f.frame), f.image);
-      for (const auto& v : f.vps) {
-        vps[static_cast<size_t>(f.frame)].push_back({f.frame, jvl::sim::ToString(v.kind), v.group,
-                                                     v.direction_cam, v.uv, v.in_image,
-                                                     v.buildings});
-      }
-      progress.Tick();
-    });
-    const double frame_s = frames_timer.ElapsedSeconds();
-    std::vector<jvl::io::GtVpRow> rows;
-    for (const auto& v : vps) rows.insert(rows.end(), v.begin(), v.end());
     tool.SetDatasetId("sim:" + scenario + ":" + std::to_string(opt.seed));
-    const auto prov = tool.MakeProvenance();
-    jvl::io::WriteGtVpsCsv(layout.SimDir() + "/gt_vps.csv", rows);
-    jvl::io::WriteGtVpsJson(layout.SimDir() + "/gt_vps.json", opt.calibration.Camera(0),
-                            world->ground_truth.frames, rows, prov);
-    jvl::io::WriteSceneJson(layout.SimDir() + "/scene.json", jvl::sim::DescribeScene(*world), prov);
+    jvl::Progress progress("sim_sequence", static_cast<int64_t>(world->ground_truth.size()),
+                           !tool.quiet());
+    const auto st = jvl::sim::WriteSequence(*world, output, sequence, tool.threads(),
+                                            [&] { return tool.MakeProvenance(); },
+                                            [&] { progress.Tick(); });
     const auto rs = jvl::sim::SummarizeRoute(*world);
-    spdlog::info("wrote {} frames to {} in {:.1f} s ({:.1f} frames/s on {} threads); {:.0f} m, "
+    spdlog::info("wrote {} frames under {} in {:.1f} s ({:.1f} frames/s on {} threads); {:.0f} m, "
                  "{:.1f}-{:.1f} m/s, {} straights >= 100 m, {} turns",
-                 vps.size(), layout.SequenceDir(), frame_s, vps.size() / frame_s, tool.threads(),
+                 st.frames, output, st.frame_seconds, st.frames / st.frame_seconds, tool.threads(),
                  rs.driven_length_m, rs.min_speed, rs.max_speed, rs.straights_100m, rs.turns);
   });
 }
