@@ -53,11 +53,11 @@ std::string FormatGtVpsCsv(const std::vector<GtVpRow>& rows) {
   std::ostringstream os;
   os << "frame,kind,group,dx,dy,dz,u,v,in_image,buildings\n";
   for (const GtVpRow& r : rows) {
-    os << r.frame << ',' << r.kind << ',' << r.group << ','
-       << FormatDouble(r.direction.x(), "%.9f") << ',' << FormatDouble(r.direction.y(), "%.9f")
-       << ',' << FormatDouble(r.direction.z(), "%.9f") << ',' << FormatDouble(r.uv.x(), "%.4f")
-       << ',' << FormatDouble(r.uv.y(), "%.4f") << ',' << (r.in_image ? 1 : 0) << ','
-       << r.buildings << '\n';
+    os << r.frame << ',' << r.kind << ',' << r.group << ',' << FormatDouble(r.direction.x(), "%.9f")
+       << ',' << FormatDouble(r.direction.y(), "%.9f") << ','
+       << FormatDouble(r.direction.z(), "%.9f") << ',' << FormatDouble(r.uv.x(), "%.4f") << ','
+       << FormatDouble(r.uv.y(), "%.4f") << ',' << (r.in_image ? 1 : 0) << ',' << r.buildings
+       << '\n';
   }
   return os.str();
 }
@@ -114,9 +114,13 @@ void WriteGtVpsJson(const std::string& path, const PinholeCamera& camera,
     } else {
       uv = nullptr;
     }
-    vps.push_back({{"frame", r.frame}, {"kind", r.kind}, {"group", r.group},
+    vps.push_back({{"frame", r.frame},
+                   {"kind", r.kind},
+                   {"group", r.group},
                    {"direction", {r.direction.x(), r.direction.y(), r.direction.z()}},
-                   {"uv", uv}, {"in_image", r.in_image}, {"buildings", r.buildings}});
+                   {"uv", uv},
+                   {"in_image", r.in_image},
+                   {"buildings", r.buildings}});
   }
   body["vps"] = vps;
   WriteJsonArtifact(path, "sim_vps", 1, body, provenance);

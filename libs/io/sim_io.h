@@ -37,7 +37,7 @@ struct GtVpRow {
   std::string kind;  // road | building_along | building_across | vertical
   int group = -1;
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // Unit, camera frame, z >= 0.
-  Eigen::Vector2d uv = Eigen::Vector2d::Zero();        // NaN when at infinity.
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();         // NaN when at infinity.
   bool in_image = false;
   int buildings = 0;
 };

@@ -12,9 +12,9 @@ struct RouteSummary {
   double driven_length_m = 0;  // Along the ground-truth poses.
   double duration_s = 0;
   double min_speed = 0, max_speed = 0, mean_speed = 0;  // m/s between frames.
-  int straights_100m = 0;      // Straight pieces of >= 100 m fully driven.
-  int turns = 0;               // Arc pieces fully driven.
-  int sharp_turns = 0;         // Of which radius < 50 m.
+  int straights_100m = 0;                               // Straight pieces of >= 100 m fully driven.
+  int turns = 0;                                        // Arc pieces fully driven.
+  int sharp_turns = 0;                                  // Of which radius < 50 m.
 };
 RouteSummary SummarizeRoute(const World& world);
 

@@ -8,10 +8,14 @@ namespace jvl::sim {
 
 const char* ToString(VpKind kind) {
   switch (kind) {
-    case VpKind::kRoad: return "road";
-    case VpKind::kBuildingAlong: return "building_along";
-    case VpKind::kBuildingAcross: return "building_across";
-    case VpKind::kVertical: return "vertical";
+    case VpKind::kRoad:
+      return "road";
+    case VpKind::kBuildingAlong:
+      return "building_along";
+    case VpKind::kBuildingAcross:
+      return "building_across";
+    case VpKind::kVertical:
+      return "vertical";
   }
   return "?";
 }
@@ -72,10 +76,15 @@ std::vector<GtVanishingPoint> ComputeGroundTruthVps(const Scene& scene, const Pi
     if (BuildingInView(b, scene.terrain, camera, cam_from_map)) ++in_view[b.axis_group];
   }
   for (const auto& [group, count] : in_view) {
-    const double yaw = scene.axis_group_yaw[group];
+    // "Along" is the group axis closer to the road direction at the vehicle.
+    double yaw = scene.axis_group_yaw[group];
+    if (std::abs(std::cos(yaw - rp.heading)) < std::abs(std::sin(yaw - rp.heading))) {
+      yaw += 1.5707963267948966;
+    }
     for (VpKind kind : {VpKind::kBuildingAlong, VpKind::kBuildingAcross}) {
       const double a = kind == VpKind::kBuildingAlong ? yaw : yaw + 1.5707963267948966;
-      GtVanishingPoint vp = ProjectDirection(camera, R * Eigen::Vector3d(std::cos(a), std::sin(a), 0));
+      GtVanishingPoint vp =
+          ProjectDirection(camera, R * Eigen::Vector3d(std::cos(a), std::sin(a), 0));
       vp.kind = kind;
       vp.group = group;
       vp.buildings = count;

@@ -17,11 +17,11 @@ const char* ToString(VpKind kind);
 
 struct GtVanishingPoint {
   VpKind kind = VpKind::kRoad;
-  int group = -1;                // Building axis group (-1 for road and vertical).
+  int group = -1;                 // Building axis group (-1 for road and vertical).
   Eigen::Vector3d direction_cam;  // Unit, camera frame, sign chosen so that z >= 0.
-  Eigen::Vector2d uv;            // Pixel position; NaN when the direction is parallel to the image.
+  Eigen::Vector2d uv;  // Pixel position; NaN when the direction is parallel to the image.
   bool in_image = false;
-  int buildings = 0;             // Buildings of the group in view (0 for road/vertical).
+  int buildings = 0;  // Buildings of the group in view (0 for road/vertical).
 };
 
 // map_from_cam: camera pose in the map frame; s: the vehicle's arc length on the route.

@@ -40,8 +40,8 @@ std::vector<double> LidarOptions::ElevationsRad() const {
 }
 
 PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid3d& world_from_velo,
-                        const std::vector<Box>& moving, const LidarOptions& options,
-                        uint64_t seed, const SweepPose* sweep_pose) {
+                        const std::vector<Box>& moving, const LidarOptions& options, uint64_t seed,
+                        const SweepPose* sweep_pose) {
   const std::vector<double> elev = options.ElevationsRad();
   const int nb = static_cast<int>(elev.size()), na = options.azimuth_steps;
   std::vector<double> ce(nb), se(nb);

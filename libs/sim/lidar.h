@@ -19,11 +19,11 @@ struct LidarOptions {
   int azimuth_steps = 2000;
   double max_range = 120.0;
   double min_range = 2.5;
-  double range_noise = 0.02;    // Standard deviation (m).
-  double dropout = 0.02;        // Probability of a missing return on any surface.
-  double glass_dropout = 0.6;   // Probability of no return from a window pane.
+  double range_noise = 0.02;       // Standard deviation (m).
+  double dropout = 0.02;           // Probability of a missing return on any surface.
+  double glass_dropout = 0.6;      // Probability of no return from a window pane.
   bool motion_distortion = false;  // Move the sensor during the sweep (like raw KITTI scans).
-  double sweep_period = 0.1;    // s
+  double sweep_period = 0.1;       // s
   void Check() const;
   // Beam elevations (radians), highest first. The HDL-64E has two blocks of 32 lasers; the
   // upper block is denser (about 1/3 deg) than the lower one (about 1/2 deg).
@@ -37,7 +37,7 @@ using SweepPose = std::function<Rigid3d(double tau)>;
 // first), azimuth from behind the car going clockwise as seen from above (as in KITTI).
 // Intensity = reflectance x incidence term. `seed` selects the noise.
 PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid3d& world_from_velo,
-                        const std::vector<Box>& moving, const LidarOptions& options,
-                        uint64_t seed, const SweepPose* sweep_pose = nullptr);
+                        const std::vector<Box>& moving, const LidarOptions& options, uint64_t seed,
+                        const SweepPose* sweep_pose = nullptr);
 
 }  // namespace jvl::sim

@@ -16,14 +16,14 @@ namespace jvl::sim {
 struct PriorOptions {
   uint64_t seed = 1;
   // Accumulating rotation errors (degrees; "per sqrt(m)" = random-walk density over distance).
-  double yaw_bias_deg_per_100m = 0.0;    // Constant part of the yaw drift.
-  double yaw_bias_walk = 0.0;            // deg/100m per sqrt(100 m): walk of the yaw-rate bias.
-  double yaw_noise_deg = 0.0;            // deg per sqrt(100 m): white yaw noise.
-  double pitch_roll_walk = 0.0;          // deg/100m per sqrt(100 m), pitch and roll biases.
-  double pitch_roll_noise_deg = 0.0;     // deg per sqrt(100 m).
+  double yaw_bias_deg_per_100m = 0.0;  // Constant part of the yaw drift.
+  double yaw_bias_walk = 0.0;          // deg/100m per sqrt(100 m): walk of the yaw-rate bias.
+  double yaw_noise_deg = 0.0;          // deg per sqrt(100 m): white yaw noise.
+  double pitch_roll_walk = 0.0;        // deg/100m per sqrt(100 m), pitch and roll biases.
+  double pitch_roll_noise_deg = 0.0;   // deg per sqrt(100 m).
   // Scale: length factor 1 + bias + walk.
-  double scale_bias = 0.0;               // Relative (0.01 = 1 %).
-  double scale_walk = 0.0;               // Relative per sqrt(100 m).
+  double scale_bias = 0.0;  // Relative (0.01 = 1 %).
+  double scale_walk = 0.0;  // Relative per sqrt(100 m).
   // Per-frame jitter that does not accumulate.
   double jitter_translation_m = 0.0;
   double jitter_rotation_deg = 0.0;

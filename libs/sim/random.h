@@ -20,8 +20,8 @@ inline uint64_t HashCombine(uint64_t a, uint64_t b) { return Mix64(a ^ Mix64(b))
 
 // Uniform [0, 1) from a hash of three integers (lattice values of the noise functions).
 inline double HashUnit(int64_t a, int64_t b, uint64_t seed) {
-  const uint64_t h = HashCombine(HashCombine(seed, static_cast<uint64_t>(a)),
-                                 static_cast<uint64_t>(b));
+  const uint64_t h =
+      HashCombine(HashCombine(seed, static_cast<uint64_t>(a)), static_cast<uint64_t>(b));
   return static_cast<double>(h >> 11) * (1.0 / 9007199254740992.0);
 }
 

@@ -18,14 +18,13 @@ RayCaster::RayCaster(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
   JVL_CHECK(!mesh.triangles.empty(), "scene mesh is empty");
   impl_->mesh = &mesh;
   impl_->device = rtcNewDevice("threads=1");
-  JVL_CHECK(impl_->device != nullptr, "cannot create the Embree device (error "
-                                          << rtcGetDeviceError(nullptr) << ")");
+  JVL_CHECK(impl_->device != nullptr,
+            "cannot create the Embree device (error " << rtcGetDeviceError(nullptr) << ")");
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                        RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                        mesh.vertices.size()));
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {
     v[3 * i] = mesh.vertices[i].x();
     v[3 * i + 1] = mesh.vertices[i].y();

@@ -14,8 +14,8 @@ namespace jvl::sim {
 struct Hit {
   double t = std::numeric_limits<double>::infinity();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // Unit, facing the ray origin.
-  int32_t face = -1;     // Face of the static mesh, or -1.
-  int32_t dynamic = -1;  // Index of the moving box hit, or -1.
+  int32_t face = -1;                                 // Face of the static mesh, or -1.
+  int32_t dynamic = -1;                              // Index of the moving box hit, or -1.
   bool valid() const { return face >= 0 || dynamic >= 0; }
 };
 

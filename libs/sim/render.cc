@@ -22,7 +22,8 @@ void CameraOptions::Check() const {
 double ExposureGain(int64_t frame, double variation, uint64_t seed) {
   const double k = static_cast<double>(frame);
   const double p1 = 6.2832 * HashUnit(3, 1, seed), p2 = 6.2832 * HashUnit(3, 2, seed);
-  const double slow = 0.6 * std::sin(6.2832 * k / 157.0 + p1) + 0.4 * std::sin(6.2832 * k / 41.0 + p2);
+  const double slow =
+      0.6 * std::sin(6.2832 * k / 157.0 + p1) + 0.4 * std::sin(6.2832 * k / 41.0 + p2);
   const double jitter = 0.15 * (2 * HashUnit(frame, 4, seed) - 1);
   return 1.0 + variation * (slow + jitter);
 }

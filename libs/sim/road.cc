@@ -140,7 +140,8 @@ double Route::Distance(const Eigen::Vector2d& p) const {
 double Terrain::Height(double x, double y) const {
   const double u[3] = {x, y, (x + y) * 0.7071};
   double h = 0;
-  for (int i = 0; i < 3; ++i) h += amplitude[i] * std::sin(2 * kPi * u[i] / wavelength[i] + phase[i]);
+  for (int i = 0; i < 3; ++i)
+    h += amplitude[i] * std::sin(2 * kPi * u[i] / wavelength[i] + phase[i]);
   return h;
 }
 
@@ -164,9 +165,12 @@ Scenario ParseScenario(const std::string& name) {
 
 std::string ToString(Scenario scenario) {
   switch (scenario) {
-    case Scenario::kUrban: return "urban";
-    case Scenario::kSuburban: return "suburban";
-    case Scenario::kHighway: return "highway";
+    case Scenario::kUrban:
+      return "urban";
+    case Scenario::kSuburban:
+      return "suburban";
+    case Scenario::kHighway:
+      return "highway";
   }
   return "?";
 }
@@ -175,13 +179,11 @@ std::vector<RoadPiece> ScenarioRoute(Scenario scenario) {
   switch (scenario) {
     case Scenario::kUrban:
       // ~471 m: two long straights, three 90-degree corners, one gentle bend, an open stretch.
-      return {Straight(130, 10.5), Turn(90, 12, 5.0),   Straight(110, 11.0),
-              Turn(-30, 150, 9.0), Straight(55, 11.5, true), Turn(90, 12, 5.0),
-              Straight(60, 10.0)};
+      return {Straight(130, 10.5),      Turn(90, 12, 5.0), Straight(110, 11.0), Turn(-30, 150, 9.0),
+              Straight(55, 11.5, true), Turn(90, 12, 5.0), Straight(60, 10.0)};
     case Scenario::kSuburban:
-      return {Straight(120, 10.0), Turn(-90, 15, 5.5), Straight(140, 11.0),
-              Turn(45, 60, 8.0),   Straight(70, 11.0, true), Turn(-90, 15, 5.5),
-              Straight(60, 10.0)};
+      return {Straight(120, 10.0),      Turn(-90, 15, 5.5), Straight(140, 11.0), Turn(45, 60, 8.0),
+              Straight(70, 11.0, true), Turn(-90, 15, 5.5), Straight(60, 10.0)};
     case Scenario::kHighway:
       return {Straight(320, 20.0), Turn(20, 600, 20.0), Straight(300, 21.0, true),
               Turn(-15, 700, 20.0), Straight(200, 20.0)};
@@ -263,8 +265,8 @@ Rigid3d VehiclePose(const Route& route, const Terrain& terrain, const Drive& dri
   const Eigen::Vector2d fwd(std::cos(yaw), std::sin(yaw)), left(-std::sin(yaw), std::cos(yaw));
   const double pitch = -std::atan(g.dot(fwd));
   const double lat_acc = v * v * rp.curvature;
-  const double roll = std::atan(g.dot(left)) + 0.0087 * lat_acc +
-                      0.003 * std::sin(2 * kPi * s / 23.0 + 2 * phase);
+  const double roll =
+      std::atan(g.dot(left)) + 0.0087 * lat_acc + 0.003 * std::sin(2 * kPi * s / 23.0 + 2 * phase);
   const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
                                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
                                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());

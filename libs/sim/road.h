@@ -75,8 +75,8 @@ std::vector<RoadPiece> ScenarioRoute(Scenario scenario);
 
 struct DriveOptions {
   double frame_rate_hz = 10.0;
-  double max_accel = 1.2;    // m/s^2
-  double max_decel = 1.8;    // m/s^2
+  double max_accel = 1.2;      // m/s^2
+  double max_decel = 1.8;      // m/s^2
   double lane_offset = -1.75;  // Right-hand traffic: centre of the right lane.
   double lane_wobble = 0.12;   // Amplitude (m) of lane-keeping weaving.
   double stop_at_s = -1;       // Arc length of a stop (< 0: no stop).

@@ -1,10 +1,11 @@
+#include "sim/road.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "sim/describe.h"
 #include "sim/prior.h"
-#include "sim/road.h"
 #include "sim/sequence.h"
 
 namespace jvl::sim {

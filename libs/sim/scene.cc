@@ -24,8 +24,10 @@ bool RectanglesOverlap(const std::array<Eigen::Vector2d, 4>& a,
       const Eigen::Vector2d n(-e.y(), e.x());
       const Eigen::Vector2d axis = n.normalized();
       double amin = 1e18, amax = -1e18, bmin = 1e18, bmax = -1e18;
-      for (const auto& p : a) amin = std::min(amin, p.dot(axis)), amax = std::max(amax, p.dot(axis));
-      for (const auto& p : b) bmin = std::min(bmin, p.dot(axis)), bmax = std::max(bmax, p.dot(axis));
+      for (const auto& p : a)
+        amin = std::min(amin, p.dot(axis)), amax = std::max(amax, p.dot(axis));
+      for (const auto& p : b)
+        bmin = std::min(bmin, p.dot(axis)), bmax = std::max(bmax, p.dot(axis));
       if (amax + margin < bmin || bmax + margin < amin) return false;
     }
   }
@@ -52,9 +54,12 @@ struct BuildingStyle {
 
 BuildingStyle StyleFor(Scenario s) {
   switch (s) {
-    case Scenario::kUrban: return {12, 30, 10, 16, 1.0, 0.35, 4, 12, 3, 6, 0.0};
-    case Scenario::kSuburban: return {8, 14, 8, 12, 3.0, 0.85, 6, 16, 1, 2, 3.0};
-    case Scenario::kHighway: return {30, 60, 15, 25, 4.0, 1.0, 25, 70, 2, 3, 18.0};
+    case Scenario::kUrban:
+      return {12, 30, 10, 16, 1.0, 0.35, 4, 12, 3, 6, 0.0};
+    case Scenario::kSuburban:
+      return {8, 14, 8, 12, 3.0, 0.85, 6, 16, 1, 2, 3.0};
+    case Scenario::kHighway:
+      return {30, 60, 15, 25, 4.0, 1.0, 25, 70, 2, 3, 18.0};
   }
   return {};
 }
@@ -100,14 +105,16 @@ void PlaceBuildings(Scene& scene, Rng& rng) {
       }
     }
   }
-  // Axis groups: buildings whose yaw (mod 180 deg) agrees within 1 degree share a group.
+  // Axis groups: buildings whose yaw agrees modulo 90 deg within 1 degree share a group (a
+  // Manhattan frame: the blocks of a perpendicular street have the same two axes).
+  const double q = kPi / 2;
   for (Building& b : scene.buildings) {
-    double yaw = std::fmod(b.yaw, kPi);
-    if (yaw < 0) yaw += kPi;
+    double yaw = std::fmod(b.yaw, q);
+    if (yaw < 0) yaw += q;
     b.axis_group = -1;
     for (size_t g = 0; g < scene.axis_group_yaw.size(); ++g) {
       double d = std::abs(yaw - scene.axis_group_yaw[g]);
-      d = std::min(d, kPi - d);
+      d = std::min(d, q - d);
       if (d < kPi / 180) b.axis_group = static_cast<int>(g);
     }
     if (b.axis_group < 0) {
@@ -126,8 +133,8 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
       const RoadPoint rp = scene.route.At(s + (side > 0 ? 12 : 0));
       const Eigen::Vector2d p = rp.position + side * Normal(rp.heading) * (hw + 0.8);
       if (scene.route.Distance(p) < hw + 0.5 || InsideAnyBuilding(scene, p, 0.5)) continue;
-      scene.poles.push_back({Eigen::Vector3d(p.x(), p.y(), tr.Height(p.x(), p.y())), 0.12,
-                             rng.Uniform(6.5, 8.5)});
+      scene.poles.push_back(
+          {Eigen::Vector3d(p.x(), p.y(), tr.Height(p.x(), p.y())), 0.12, rng.Uniform(6.5, 8.5)});
     }
   }
   for (double s = rng.Uniform(20, 40); s < len; s += rng.Uniform(55, 85)) {
@@ -136,8 +143,8 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
     if (scene.route.Distance(p) < hw + 0.8 || InsideAnyBuilding(scene, p, 0.5)) continue;
     const double z = tr.Height(p.x(), p.y());
     scene.poles.push_back({Eigen::Vector3d(p.x(), p.y(), z), 0.04, 2.6});
-    scene.signs.push_back({Eigen::Vector3d(p.x(), p.y(), z + 2.25), rp.heading,
-                           Eigen::Vector3d(0.06, 0.75, 0.75)});
+    scene.signs.push_back(
+        {Eigen::Vector3d(p.x(), p.y(), z + 2.25), rp.heading, Eigen::Vector3d(0.06, 0.75, 0.75)});
   }
   if (scene.options.scenario == Scenario::kHighway) return;
   for (const RoadPiece& piece : scene.route.pieces()) {
@@ -195,15 +202,24 @@ void PlaceMovingCars(Scene& scene, Rng& rng) {
 
 const char* ToString(Material m) {
   switch (m) {
-    case Material::kGround: return "ground";
-    case Material::kFacade: return "facade";
-    case Material::kRoof: return "roof";
-    case Material::kKerb: return "kerb";
-    case Material::kPole: return "pole";
-    case Material::kSign: return "sign";
-    case Material::kCar: return "car";
-    case Material::kFoliage: return "foliage";
-    case Material::kTrunk: return "trunk";
+    case Material::kGround:
+      return "ground";
+    case Material::kFacade:
+      return "facade";
+    case Material::kRoof:
+      return "roof";
+    case Material::kKerb:
+      return "kerb";
+    case Material::kPole:
+      return "pole";
+    case Material::kSign:
+      return "sign";
+    case Material::kCar:
+      return "car";
+    case Material::kFoliage:
+      return "foliage";
+    case Material::kTrunk:
+      return "trunk";
   }
   return "?";
 }
@@ -232,7 +248,8 @@ Box Scene::MovingCarBox(size_t i, double t) const {
   }
   const RoadPoint rp = route.At(s);
   const Eigen::Vector2d p = rp.position + car.lateral * Normal(rp.heading);
-  box.center = Eigen::Vector3d(p.x(), p.y(), terrain.Height(p.x(), p.y()) + car.size.z() / 2 + 0.15);
+  box.center =
+      Eigen::Vector3d(p.x(), p.y(), terrain.Height(p.x(), p.y()) + car.size.z() / 2 + 0.15);
   box.yaw = rp.heading + (car.speed < 0 ? kPi : 0.0);
   box.size = car.size;
   return box;

@@ -85,9 +85,9 @@ struct Plant {
 };
 
 struct MovingCar {
-  double s0 = 0;        // Route arc length at t = 0.
-  double speed = 0;     // Along the route (negative: oncoming traffic).
-  double lateral = 0;   // Offset from the centre line (left +).
+  double s0 = 0;       // Route arc length at t = 0.
+  double speed = 0;    // Along the route (negative: oncoming traffic).
+  double lateral = 0;  // Offset from the centre line (left +).
   Eigen::Vector3d size{4.3, 1.8, 1.5};
 };
 

@@ -87,10 +87,10 @@ void AddBlob(Mesh& mesh, const Eigen::Vector3d& c, double radius, Rng& rng) {
   std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
                                     {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
                                     {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<std::array<int, 3>> f = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-      {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   std::map<std::pair<int, int>, int> mid;
   auto midpoint = [&](int a, int b) {
     const auto key = std::minmax(a, b);
@@ -102,7 +102,8 @@ void AddBlob(Mesh& mesh, const Eigen::Vector3d& c, double radius, Rng& rng) {
   };
   std::vector<std::array<int, 3>> g;
   for (const auto& tri : f) {
-    const int a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]), d = midpoint(tri[2], tri[0]);
+    const int a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]),
+              d = midpoint(tri[2], tri[0]);
     g.push_back({tri[0], a, d});
     g.push_back({tri[1], b, a});
     g.push_back({tri[2], d, b});
@@ -166,7 +167,8 @@ void BuildSceneMesh(Scene& scene, Rng& rng) {
     AddBox(mesh, b.center, b.yaw, b.length, b.depth, b.base_z, ground + b.height, ground,
            Material::kFacade, Material::kRoof, static_cast<int32_t>(i), b.albedo);
   }
-  for (const Pole& p : scene.poles) AddPrism(mesh, p.base, p.radius, p.height, Material::kPole, 0.5f);
+  for (const Pole& p : scene.poles)
+    AddPrism(mesh, p.base, p.radius, p.height, Material::kPole, 0.5f);
   for (const Box& s : scene.signs) {
     const double z0 = s.center.z() - s.size.z() / 2;
     AddBox(mesh, s.center.head<2>(), s.yaw, s.size.x(), s.size.y(), z0, z0 + s.size.z(), z0,

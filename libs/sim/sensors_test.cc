@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -83,7 +84,8 @@ TEST(RenderTest, KnownPointProjectsToTheRightPixel) {
       Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())) *
           Eigen::Quaterniond(Eigen::AngleAxisd(-0.05, Eigen::Vector3d::UnitX())),
       Eigen::Vector3d(5, -1, 2));
-  for (const Eigen::Vector2d& target : {Eigen::Vector2d(900.3, 250.7), Eigen::Vector2d(201.6, 80.2)}) {
+  for (const Eigen::Vector2d& target :
+       {Eigen::Vector2d(900.3, 250.7), Eigen::Vector2d(201.6, 80.2)}) {
     const Eigen::Vector3d x_cam = 12.0 * cam.Unproject(target);
     Scene scene;
     // A thin 0.3 m plate facing the camera, centred on x_cam and axis-aligned in the camera
@@ -150,6 +152,10 @@ TEST(RenderTest, FeaturesLandOnStructure) {
     ++long_lines;
     on_facade += label((l[0] + l[2]) / 2, (l[1] + l[3]) / 2) == 0 ? 1 : 0;
   }
+  std::printf(
+      "frame 10: ORB %zu keypoints: facade %d, lane marking %d, other %d, sky %d; "
+      "LSD %d segments >= 30 px, %d on facades\n",
+      kps.size(), counts[0], counts[1], counts[2], counts[3], long_lines, on_facade);
   EXPECT_GT(long_lines, 50);
   EXPECT_GT(on_facade, long_lines / 3);
 }
@@ -171,15 +177,16 @@ TEST(GroundTruthTest, RoadVpIsTheProjectionOfTheRoadDirection) {
     const RoadPoint rp = world->scene.route.At(s);
     const Eigen::Vector2d tan(std::cos(rp.heading), std::sin(rp.heading));
     const double slope = world->scene.terrain.Gradient(rp.position.x(), rp.position.y()).dot(tan);
-    const Eigen::Vector3d far =
-        Eigen::Vector3d(rp.position.x(), rp.position.y(), 0) + 1e7 * Eigen::Vector3d(tan.x(), tan.y(), slope);
+    const Eigen::Vector3d far = Eigen::Vector3d(rp.position.x(), rp.position.y(), 0) +
+                                1e7 * Eigen::Vector3d(tan.x(), tan.y(), slope);
     const Eigen::Vector2d uv = cam.Project(map_from_cam.Inverse() * far);
     EXPECT_LT((uv - road.uv).norm(), 0.5) << "frame " << k;
     // Lane edge lines (+-3.5 m) between 25 and 45 m ahead meet near the VP (the terrain bends
     // them slightly).
     auto edge = [&](double lat, double ahead) {
       const RoadPoint q = world->scene.route.At(s + ahead);
-      const Eigen::Vector2d p = q.position + lat * Eigen::Vector2d(-std::sin(q.heading), std::cos(q.heading));
+      const Eigen::Vector2d p =
+          q.position + lat * Eigen::Vector2d(-std::sin(q.heading), std::cos(q.heading));
       const Eigen::Vector3d x(p.x(), p.y(), world->scene.terrain.Height(p.x(), p.y()));
       const Eigen::Vector2d pix = cam.Project(map_from_cam.Inverse() * x);
       return Eigen::Vector3d(pix.x(), pix.y(), 1.0);

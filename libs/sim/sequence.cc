@@ -49,8 +49,8 @@ void SequenceOptions::Check() const {
 Rigid3d World::MapFromVeloAt(double t) const {
   const Rigid3d map_from_base =
       VehiclePose(scene.route, scene.terrain, drive, options.drive, t, options.seed);
-  return map_from_base * Rigid3d(Eigen::Quaterniond::Identity(),
-                                 Eigen::Vector3d(0, 0, options.lidar_height));
+  return map_from_base *
+         Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, options.lidar_height));
 }
 
 Trajectory World::MapFromCam() const {
@@ -80,9 +80,9 @@ std::unique_ptr<World> BuildWorld(const SequenceOptions& options) {
   world->drive = PlanDrive(route, drive);
   const int64_t available =
       static_cast<int64_t>(std::floor(world->drive.duration() * drive.frame_rate_hz)) + 1;
-  JVL_CHECK(options.frames <= available,
-            "--frames " << options.frames << " exceeds the " << available << " frames of the "
-                        << ToString(options.scenario) << " route");
+  JVL_CHECK(options.frames <= available, "--frames " << options.frames << " exceeds the "
+                                                     << available << " frames of the "
+                                                     << ToString(options.scenario) << " route");
   const int64_t n = options.frames > 0 ? options.frames : available;
   const Rigid3d velo_from_cam0 = options.calibration.cam0_from_velo.Inverse();
   for (int64_t k = 0; k < n; ++k) {

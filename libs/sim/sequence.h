@@ -29,8 +29,8 @@ Calibration KittiCalibration();
 struct SequenceOptions {
   Scenario scenario = Scenario::kUrban;
   uint64_t seed = 1;
-  int64_t frames = 0;  // 0: drive the whole route.
-  bool stop = false;   // Stop for a few seconds before the second corner.
+  int64_t frames = 0;          // 0: drive the whole route.
+  bool stop = false;           // Stop for a few seconds before the second corner.
   double lidar_height = 1.73;  // Velodyne above the road (KITTI setup).
   Calibration calibration = KittiCalibration();
   DriveOptions drive;
@@ -47,9 +47,9 @@ struct World {
   Scene scene;
   std::unique_ptr<RayCaster> caster;
   Drive drive;
-  Rigid3d map_from_world;          // Map frame from the pose world frame (cam0 of frame 0).
-  Trajectory ground_truth;         // world_from_cam0 per frame, with timestamps.
-  Trajectory MapFromCam() const;   // The same poses in the map frame.
+  Rigid3d map_from_world;         // Map frame from the pose world frame (cam0 of frame 0).
+  Trajectory ground_truth;        // world_from_cam0 per frame, with timestamps.
+  Trajectory MapFromCam() const;  // The same poses in the map frame.
   Rigid3d MapFromVeloAt(double t) const;
 };
 
@@ -67,7 +67,6 @@ SimFrame SimulateFrame(const World& world, int64_t frame);
 
 // Simulates every frame on `threads` threads; sink(frame) is called from the worker threads
 // (each frame exactly once, in no particular order). Results depend only on the frame index.
-void GenerateSequence(const World& world, int threads,
-                      const std::function<void(SimFrame&&)>& sink);
+void GenerateSequence(const World& world, int threads, const std::function<void(SimFrame&&)>& sink);
 
 }  // namespace jvl::sim

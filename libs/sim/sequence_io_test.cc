@@ -80,8 +80,10 @@ TEST(SequenceIoTest, KittiReaderReadsItBack) {
   const Calibration& c = ds->calibration();
   EXPECT_NEAR(c.P[0](0, 0), 707.0912, 1e-9);
   EXPECT_NEAR(c.P[0](1, 2), 183.1104, 1e-9);
-  EXPECT_LT((c.cam0_from_velo.translation() -
-             world->options.calibration.cam0_from_velo.translation()).norm(), 1e-9);
+  EXPECT_LT(
+      (c.cam0_from_velo.translation() - world->options.calibration.cam0_from_velo.translation())
+          .norm(),
+      1e-9);
   ASSERT_TRUE(ds->ground_truth().has_value());
   for (size_t k = 0; k < 4; ++k) {
     const Eigen::Vector3d d = ds->ground_truth()->world_from_cam[k].translation() -
@@ -104,7 +106,8 @@ TEST(SequenceIoTest, KittiReaderReadsItBack) {
 }
 
 // Every field the schemas require is present in what the writer produces.
-void CheckRequired(const nlohmann::json& schema, const nlohmann::json& value, const std::string& at) {
+void CheckRequired(const nlohmann::json& schema, const nlohmann::json& value,
+                   const std::string& at) {
   if (schema.contains("required")) {
     for (const auto& key : schema["required"]) {
       EXPECT_TRUE(value.contains(key.get<std::string>())) << at << " lacks " << key;
@@ -114,8 +117,9 @@ void CheckRequired(const nlohmann::json& schema, const nlohmann::json& value, co
   for (auto it = schema["properties"].begin(); it != schema["properties"].end(); ++it) {
     if (!value.contains(it.key())) continue;
     const auto& sub = it.value();
- const auto& v = value[it.key()];
-    const std::string type = sub.contains("type") && sub["type"].is_string() ? sub["type"].get<std::string>() : "";
+    const auto& v = value[it.key()];
+    const std::string type =
+        sub.contains("type") && sub["type"].is_string() ? sub["type"].get<std::string>() : "";
     if (type == "array" && sub.contains("items") && v.is_array() && !v.empty()) {
       CheckRequired(sub["items"], v[0], at + "/" + it.key() + "[0]");
     } else if (type == "object") {

@@ -22,7 +22,7 @@ Surface ShadeGround(const Scene& scene, const Eigen::Vector3d& p) {
   if (a <= hw) {
     out.albedo = static_cast<float>(0.22 + 0.07 * coarse + 0.05 * fine);
     out.reflectance = 0.12f;
-    bool mark = std::abs(a - 3.5) < 0.08;                    // Solid lane edge lines.
+    bool mark = std::abs(a - 3.5) < 0.08;                     // Solid lane edge lines.
     mark = mark || (a < 0.07 && Fract(s / 9.0) < 1.0 / 3.0);  // Dashed centre line 3 m / 6 m.
     // Zebra crossings 6-10 m before every sharp corner.
     for (const RoadPiece& piece : scene.route.pieces()) {
@@ -67,8 +67,8 @@ Surface ShadeFacade(const Scene& scene, const Face& f, const Eigen::Vector3d& p)
   const double fv = v - floor * b.floor_height;
   const double margin = 1.2;
   const double usable = f.width - 2 * margin;
-  const int cols = static_cast<int>(std::floor((usable + b.window_spacing - b.window_width) /
-                                               b.window_spacing));
+  const int cols =
+      static_cast<int>(std::floor((usable + b.window_spacing - b.window_width) / b.window_spacing));
   const double offset = margin + 0.5 * (usable - (cols - 1) * b.window_spacing - b.window_width);
   const double cu = (u - offset) / b.window_spacing;
   const int col = static_cast<int>(std::floor(cu));
@@ -108,14 +108,22 @@ Surface ShadeSurface(const Scene& scene, const Hit& hit, const Eigen::Vector3d& 
   const Face& f = scene.mesh.faces[hit.face];
   auto noise = [&] { return ValueNoise(p.x() * 4, p.y() * 4 + p.z() * 4, scene.options.seed + 9); };
   switch (f.material) {
-    case Material::kGround: return ShadeGround(scene, p);
-    case Material::kFacade: return ShadeFacade(scene, f, p);
-    case Material::kRoof: out.albedo = 0.35f; out.reflectance = 0.25f; break;
+    case Material::kGround:
+      return ShadeGround(scene, p);
+    case Material::kFacade:
+      return ShadeFacade(scene, f, p);
+    case Material::kRoof:
+      out.albedo = 0.35f;
+      out.reflectance = 0.25f;
+      break;
     case Material::kKerb:
       out.albedo = static_cast<float>(0.68 + 0.1 * (noise() - 0.5));
       out.reflectance = 0.4f;
       break;
-    case Material::kPole: out.albedo = 0.5f; out.reflectance = 0.4f; break;
+    case Material::kPole:
+      out.albedo = 0.5f;
+      out.reflectance = 0.4f;
+      break;
     case Material::kSign: {
       const Eigen::Vector3f q = p.cast<float>() - f.origin;
       const double u = q.dot(f.u), v = q.dot(f.v);
@@ -124,12 +132,18 @@ Surface ShadeSurface(const Scene& scene, const Hit& hit, const Eigen::Vector3d& 
       out.reflectance = 0.95f;
       break;
     }
-    case Material::kCar: out.albedo = f.albedo; out.reflectance = 0.35f; break;
+    case Material::kCar:
+      out.albedo = f.albedo;
+      out.reflectance = 0.35f;
+      break;
     case Material::kFoliage:
       out.albedo = static_cast<float>(f.albedo * (0.55 + 0.9 * noise()));
       out.reflectance = 0.25f;
       break;
-    case Material::kTrunk: out.albedo = 0.28f; out.reflectance = 0.3f; break;
+    case Material::kTrunk:
+      out.albedo = 0.28f;
+      out.reflectance = 0.3f;
+      break;
   }
   return out;
 }

@@ -10,8 +10,7 @@
 namespace jvl::sim {
 
 WriteStats WriteSequence(const World& world, const std::string& root, const std::string& sequence,
-                         int threads,
-                         const std::function<io::Provenance()>& provenance,
+                         int threads, const std::function<io::Provenance()>& provenance,
                          const std::function<void()>& tick) {
   const SequenceOptions& opt = world.options;
   const io::KittiLayout layout{root, sequence};

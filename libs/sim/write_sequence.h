@@ -16,10 +16,10 @@ struct WriteStats {
   double frame_seconds = 0;  // Wall time of the frame loop.
 };
 
-// `provenance` is asked for after the frames are written (wall time); `tick` is called once per finished frame (progress display), from worker threads.
+// `provenance` is asked for after the frames are written (wall time); `tick` is called once per
+// finished frame (progress display), from worker threads.
 WriteStats WriteSequence(const World& world, const std::string& root, const std::string& sequence,
-                         int threads,
-                         const std::function<io::Provenance()>& provenance,
+                         int threads, const std::function<io::Provenance()>& provenance,
                          const std::function<void()>& tick = {});
 
 }  // namespace jvl::sim

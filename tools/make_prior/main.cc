@@ -33,9 +33,10 @@ int main(int argc, char** argv) {
       jvl::io::WriteTrajectoryKitti(output, prior);
     }
     const auto st = jvl::sim::ComparePrior(gt, prior);
-    spdlog::info("prior '{}' over {:.0f} m: APE rmse {:.2f} m, max {:.2f} m, final yaw error "
-                 "{:.2f} deg, rotation error {:.2f} deg",
-                 preset, st.length_m, st.ape_rmse_m, st.ape_max_m, st.final_yaw_error_deg,
-                 st.final_rotation_error_deg);
+    spdlog::info(
+        "prior '{}' over {:.0f} m: APE rmse {:.2f} m, max {:.2f} m, final yaw error "
+        "{:.2f} deg, rotation error {:.2f} deg",
+        preset, st.length_m, st.ape_rmse_m, st.ape_max_m, st.final_yaw_error_deg,
+        st.final_rotation_error_deg);
   });
 }

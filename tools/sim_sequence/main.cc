@@ -4,12 +4,15 @@
 #include <spdlog/spdlog.h>
 
 #include <cctype>
+#include <cstdio>
 
 #include "app/tool.h"
 #include "core/check.h"
 #include "core/progress.h"
 #include "core/timer.h"
+#include "io/kitti.h"
 #include "sim/describe.h"
+#include "sim/preview.h"
 #include "sim/sequence.h"
 #include "sim/write_sequence.h"
 
@@ -21,7 +24,8 @@ int main(int argc, char** argv) {
   auto& cli = tool.cli();
   cli.add_option("--output,-o", output, "Output root (KITTI odometry layout)")->required();
   cli.add_option("--sequence", sequence, "Sequence name (two digits)")->capture_default_str();
-  cli.add_option("--frames", opt.frames, "Frames to write (0 = whole route)")->capture_default_str();
+  cli.add_option("--frames", opt.frames, "Frames to write (0 = whole route)")
+      ->capture_default_str();
   cli.add_option("--scenario", scenario, "urban, suburban or highway")->capture_default_str();
   cli.add_option("--seed", opt.seed, "Random seed (world layout and noise)")->capture_default_str();
   cli.add_flag("--stop", opt.stop, "Stop for a few seconds before the second corner");
@@ -34,9 +38,13 @@ int main(int argc, char** argv) {
   cli.add_option("--pixel-noise", opt.camera.pixel_noise, "Image noise sigma (grey levels)")
       ->capture_default_str();
   cli.add_option("--exposure-variation", opt.camera.exposure_variation,
-                 "Relative frame-to-frame exposure change")->capture_default_str();
+                 "Relative frame-to-frame exposure change")
+      ->capture_default_str();
   cli.add_option("--moving-cars", opt.scene.moving_cars, "Moving cars on the route")
       ->capture_default_str();
+  int64_t preview = -1;
+  cli.add_option("--preview-frame", preview,
+                 "Also write sim/topview_<frame>.png, a bird's-eye view of that frame's scan");
   cli.add_flag("--no-images", no_images, "Do not render camera images");
   cli.add_flag("--no-scans", no_scans, "Do not simulate LiDAR scans");
   return tool.Run(argc, argv, [&] {
@@ -53,13 +61,21 @@ int main(int argc, char** argv) {
     tool.SetDatasetId("sim:" + scenario + ":" + std::to_string(opt.seed));
     jvl::Progress progress("sim_sequence", static_cast<int64_t>(world->ground_truth.size()),
                            !tool.quiet());
-    const auto st = jvl::sim::WriteSequence(*world, output, sequence, tool.threads(),
-                                            [&] { return tool.MakeProvenance(); },
-                                            [&] { progress.Tick(); });
+    const auto st = jvl::sim::WriteSequence(
+        *world, output, sequence, tool.threads(), [&] { return tool.MakeProvenance(); },
+        [&] { progress.Tick(); });
+    if (preview >= 0) {
+      const auto f = jvl::sim::SimulateFrame(*world, preview);
+      char name[64];
+      std::snprintf(name, sizeof(name), "/sequences/%s/sim/topview_%06lld.png", sequence.c_str(),
+                    static_cast<long long>(preview));
+      jvl::io::WriteImage(output + name, jvl::sim::ScanTopView(f.scan, opt.lidar_height));
+    }
     const auto rs = jvl::sim::SummarizeRoute(*world);
-    spdlog::info("wrote {} frames under {} in {:.1f} s ({:.1f} frames/s on {} threads); {:.0f} m, "
-                 "{:.1f}-{:.1f} m/s, {} straights >= 100 m, {} turns",
-                 st.frames, output, st.frame_seconds, st.frames / st.frame_seconds, tool.threads(),
-                 rs.driven_length_m, rs.min_speed, rs.max_speed, rs.straights_100m, rs.turns);
+    spdlog::info(
+        "wrote {} frames under {} in {:.1f} s ({:.1f} frames/s on {} threads); {:.0f} m, "
+        "{:.1f}-{:.1f} m/s, {} straights >= 100 m, {} turns",
+        st.frames, output, st.frame_seconds, st.frames / st.frame_seconds, tool.threads(),
+        rs.driven_length_m, rs.min_speed, rs.max_speed, rs.straights_100m, rs.turns);
   });
 }
