@@ -20,6 +20,29 @@ nlohmann::json BoxJson(const Box& b) {
   return {{"center", Vec(b.center)}, {"yaw_rad", b.yaw}, {"size", Vec(b.size)}};
 }
 
+void AddObjects(const Scene& sc, nlohmann::json& j) {
+  nlohmann::json poles = nlohmann::json::array(), signs = nlohmann::json::array();
+  nlohmann::json cars = nlohmann::json::array(), plants = nlohmann::json::array();
+  nlohmann::json moving = nlohmann::json::array();
+  for (const Pole& p : sc.poles) {
+    poles.push_back({{"base", Vec(p.base)}, {"radius", p.radius}, {"height", p.height}});
+  }
+  for (const Box& s : sc.signs) signs.push_back(BoxJson(s));
+  for (const Box& c : sc.parked_cars) cars.push_back(BoxJson(c));
+  for (const Plant& p : sc.plants) {
+    plants.push_back({{"center", Vec(p.center)}, {"radius", p.radius}, {"tree", p.tree}});
+  }
+  for (const MovingCar& m : sc.moving_cars) {
+    moving.push_back(
+        {{"s0", m.s0}, {"speed_mps", m.speed}, {"lateral", m.lateral}, {"size", Vec(m.size)}});
+  }
+  j["poles"] = poles;
+  j["signs"] = signs;
+  j["parked_cars"] = cars;
+  j["plants"] = plants;
+  j["moving_cars"] = moving;
+}
+
 }  // namespace
 
 RouteSummary SummarizeRoute(const World& world) {
@@ -116,26 +139,7 @@ nlohmann::json DescribeScene(const World& world) {
                  {"axis_group", x.axis_group}});
   }
   j["buildings"] = b;
-  nlohmann::json poles = nlohmann::json::array(), signs = nlohmann::json::array();
-  nlohmann::json cars = nlohmann::json::array(), plants = nlohmann::json::array();
-  nlohmann::json moving = nlohmann::json::array();
-  for (const Pole& p : sc.poles) {
-    poles.push_back({{"base", Vec(p.base)}, {"radius", p.radius}, {"height", p.height}});
-  }
-  for (const Box& s : sc.signs) signs.push_back(BoxJson(s));
-  for (const Box& c : sc.parked_cars) cars.push_back(BoxJson(c));
-  for (const Plant& p : sc.plants) {
-    plants.push_back({{"center", Vec(p.center)}, {"radius", p.radius}, {"tree", p.tree}});
-  }
-  for (const MovingCar& m : sc.moving_cars) {
-    moving.push_back(
-        {{"s0", m.s0}, {"speed_mps", m.speed}, {"lateral", m.lateral}, {"size", Vec(m.size)}});
-  }
-  j["poles"] = poles;
-  j["signs"] = signs;
-  j["parked_cars"] = cars;
-  j["plants"] = plants;
-  j["moving_cars"] = moving;
+  AddObjects(sc, j);
   const LidarOptions& l = world.options.lidar;
   j["lidar"] = {{"beams", l.beams},
                 {"elevation_max_deg", l.elevation_max_deg},

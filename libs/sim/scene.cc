@@ -105,8 +105,11 @@ void PlaceBuildings(Scene& scene, Rng& rng) {
       }
     }
   }
-  // Axis groups: buildings whose yaw agrees modulo 90 deg within 1 degree share a group (a
-  // Manhattan frame: the blocks of a perpendicular street have the same two axes).
+}
+
+// Axis groups: buildings whose yaw agrees modulo 90 deg within 1 degree share a group (a
+// Manhattan frame: the blocks of a perpendicular street have the same two axes).
+void AssignAxisGroups(Scene& scene) {
   const double q = kPi / 2;
   for (Building& b : scene.buildings) {
     double yaw = std::fmod(b.yaw, q);
@@ -265,6 +268,7 @@ Scene BuildScene(const Route& route, const SceneOptions& options) {
   }
   Rng rng(HashCombine(options.seed, 0x5ce7e));
   PlaceBuildings(scene, rng);
+  AssignAxisGroups(scene);
   PlaceStreetFurniture(scene, rng);
   PlacePlants(scene, rng);
   PlaceMovingCars(scene, rng);
