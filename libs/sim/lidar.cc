@@ -51,7 +51,6 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
   std::vector<float> inten(pts.size());
   std::vector<uint8_t> ok(pts.size(), 0);
   Rng rng(seed);
-  const Rigid3d velo_from_world = world_from_velo.Inverse();
   for (int a = 0; a < na; ++a) {
     const double az = kPi - 2 * kPi * a / na;  // Clockwise from behind.
     Rigid3d pose = world_from_velo;
@@ -75,9 +74,10 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
       const Surface surf = ShadeSurface(scene, hit, p);
       if (surf.glass && u_glass < options.glass_dropout) continue;
       const double r = hit.t + options.range_noise * noise;
-      const Eigen::Vector3d pw = o + r * d;
       const size_t k = static_cast<size_t>(b) * na + a;
-      pts[k] = (velo_from_world * pw).cast<float>();
+      // The sensor reports the return in its own frame at firing time: with motion distortion
+      // the scan is not compensated for the motion during the sweep (as raw KITTI scans).
+      pts[k] = (r * d_velo).cast<float>();
       const double incidence = std::abs(hit.normal.dot(d));
       inten[k] = static_cast<float>(
           std::clamp(surf.reflectance * (0.45 + 0.55 * incidence) + 0.02 * n_int, 0.0, 0.99));

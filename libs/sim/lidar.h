@@ -33,7 +33,8 @@ struct LidarOptions {
 // Sensor pose at time offset tau (s) from the frame time, for motion distortion.
 using SweepPose = std::function<Rigid3d(double tau)>;
 
-// Returns points in the velodyne frame of the frame time, ordered ring by ring (highest beam
+// Returns points in the velodyne frame (at each firing's time: with motion distortion the
+// sweep is not compensated), ordered ring by ring (highest beam
 // first), azimuth from behind the car going clockwise as seen from above (as in KITTI).
 // Intensity = reflectance x incidence term. `seed` selects the noise.
 PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid3d& world_from_velo,

@@ -200,3 +200,37 @@ TEST(GroundTruthTest, RoadVpIsTheProjectionOfTheRoadDirection) {
 
 }  // namespace
 }  // namespace jvl::sim
+
+namespace jvl::sim {
+namespace {
+
+// Moving forward at 10 m/s towards a wall 20 m ahead: without distortion the wall is at x = 20
+// in every column; with it, a column fired tau seconds from the frame time measures 20 - 10 tau
+// (tau = -0.1 az / 2 pi: the sweep runs clockwise and passes forward at the frame time).
+TEST(LidarTest, MotionDistortionShiftsColumnsByTheMotion) {
+  Scene scene;
+  AddBox(scene.mesh, Eigen::Vector2d(20.5, 0), 0.0, 1.0, 100.0, -50, 50, 0, Material::kFacade,
+         Material::kRoof, -1, 0.5f);
+  for (auto& f : scene.mesh.faces) f.material = Material::kPole;  // Plain, no windows.
+  const RayCaster caster(scene.mesh);
+  LidarOptions opt;
+  opt.range_noise = 0;
+  opt.dropout = 0;
+  const SweepPose sweep = [](double tau) {
+    return Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(10 * tau, 0, 0));
+  };
+  for (bool distort : {false, true}) {
+    opt.motion_distortion = distort;
+    const PointCloud scan = SimulateScan(scene, caster, Rigid3d(), {}, opt, 1, &sweep);
+    ASSERT_GT(scan.size(), 1000u);
+    for (const auto& p : scan.points) {
+      const double az = std::atan2(p.y(), p.x());
+      const double expected = distort ? 20.0 + az / (2 * M_PI) : 20.0;
+      EXPECT_NEAR(p.x(), expected, 2e-3) << "az " << az;
+      if (std::abs(p.x() - expected) > 2e-3) break;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace jvl::sim
