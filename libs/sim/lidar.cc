@@ -51,6 +51,7 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
   std::vector<float> inten(pts.size());
   std::vector<uint8_t> ok(pts.size(), 0);
   Rng rng(seed);
+  const NormalTable normal;
   for (int a = 0; a < na; ++a) {
     const double az = kPi - 2 * kPi * a / na;  // Clockwise from behind.
     Rigid3d pose = world_from_velo;
@@ -66,8 +67,8 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
       Hit hit = caster.Intersect(o, d, 0.05, options.max_range);
       IntersectBoxes(moving, o, d, &hit);
       // Draw the random numbers for every slot so that the stream does not depend on hits.
-      const double u_drop = rng.Uniform(), u_glass = rng.Uniform(), noise = rng.Normal();
-      const double n_int = rng.Normal();
+      const double u_drop = rng.Uniform(), u_glass = rng.Uniform(), noise = normal.Sample(rng);
+      const double n_int = normal.Sample(rng);
       if (!hit.valid() || hit.t < options.min_range || hit.t > options.max_range) continue;
       if (u_drop < options.dropout) continue;
       const Eigen::Vector3d p = o + hit.t * d;

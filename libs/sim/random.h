@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace jvl::sim {
 
@@ -53,6 +54,25 @@ class Rng {
 
  private:
   uint64_t state_;
+};
+
+// Fast approximately normal samples for per-pixel and per-return noise: 4096 fixed
+// Box-Muller values (standardised to mean 0, variance 1) indexed by 12 random bits.
+class NormalTable {
+ public:
+  NormalTable() : values_(4096) {
+    Rng rng(0x4e6f726d616cULL);
+    double mean = 0, var = 0;
+    for (double& v : values_) mean += (v = rng.Normal());
+    mean /= values_.size();
+    for (double& v : values_) var += (v - mean) * (v - mean);
+    const double scale = 1.0 / std::sqrt(var / values_.size());
+    for (double& v : values_) v = (v - mean) * scale;
+  }
+  double Sample(Rng& rng) const { return values_[rng.Next() >> 52]; }
+
+ private:
+  std::vector<double> values_;
 };
 
 // Smooth 2-D value noise in [0, 1] (bilinear over hashed lattice values, smoothstep weights).

@@ -81,11 +81,12 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
   }
   cv::Mat image(camera.height, camera.width, CV_8U);
   Rng rng(noise_seed);
+  const NormalTable normal;
   for (int j = 0; j < camera.height; ++j) {
     const float* in = radiance.ptr<float>(j);
     uint8_t* out = image.ptr<uint8_t>(j);
     for (int i = 0; i < camera.width; ++i) {
-      const double v = in[i] * gain + options.pixel_noise * rng.Normal();
+      const double v = in[i] * gain + options.pixel_noise * normal.Sample(rng);
       out[i] = static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L));
     }
   }
