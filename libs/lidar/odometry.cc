@@ -77,12 +77,13 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
   OdometryFrame out;
   out.frame = frame;
   FrameDiagnostics& d = out.diagnostics;
-  PreprocessedScan pre = PreprocessScan(velo_scan, cam0_from_velo_, options_.preprocess);
+  PreprocessedScan pre = PreprocessScan(velo_scan, cam0_from_velo_, options_.preprocess, threads_);
   d.non_finite_points = non_finite_dropped + pre.counts.non_finite;
   if (pre.counts.non_finite > 0) {
     spdlog::warn("frame {}: dropped {} non-finite points", frame, pre.counts.non_finite);
   }
   d.points_after_filter = static_cast<int64_t>(pre.points.size());
+  d.preprocess_ms = timer.ElapsedMs();
   const Rigid3d motion = PredictMotion();
   if (options_.deskew && frames_.size() >= 2) {
     // Constant velocity within the scan: a point taken at fraction s of the period was seen
@@ -93,6 +94,7 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
     }
   }
   const ScanSurface surface = ComputeSurface(pre.points, options_.surface, threads_);
+  d.surface_ms = timer.ElapsedMs() - d.preprocess_ms;
 
   if (frames_.empty()) {
     d.status = FrameStatus::kFirstFrame;
@@ -131,6 +133,7 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
                    frame, reg.degenerate_directions, reg.min_eigenvalue);
     }
   }
+  d.register_ms = timer.ElapsedMs() - d.preprocess_ms - d.surface_ms;
   UpdateModel(frame, surface, out.world_from_cam);
   d.time_ms = timer.ElapsedMs();
   frames_.push_back(out);

@@ -46,6 +46,7 @@ struct FrameDiagnostics {
   double residual = 0;          // RMS IMLS distance at the last iteration (m).
   int correspondences = 0;
   double time_ms = 0;           // Whole ProcessScan.
+  double preprocess_ms = 0, surface_ms = 0, register_ms = 0;  // Its main stages.
   bool degenerate = false;      // Any fallback to the motion model (partial or full).
   bool converged = false;
   int64_t points_after_filter = 0;

@@ -59,6 +59,8 @@ void PreprocessOptions::Check() const {
                 << vertical_correction_deg);
   JVL_CHECK(voxel_size >= 0, "--voxel-size must be >= 0, got " << voxel_size);
   JVL_CHECK(outlier_radius >= 0, "--outlier-radius must be >= 0, got " << outlier_radius);
+  JVL_CHECK(outlier_method == "grid" || outlier_method == "pcl",
+            "--outlier-method must be grid or pcl, got '" << outlier_method << "'");
   JVL_CHECK(outlier_min_neighbors >= 0,
             "--outlier-min-neighbors must be >= 0, got " << outlier_min_neighbors);
   JVL_CHECK(ground_distance > 0, "--ground-distance must be > 0, got " << ground_distance);
@@ -88,9 +90,25 @@ float AzimuthTimeFraction(const Eigen::Vector3d& velo_point) {
 }
 
 std::vector<uint8_t> RadiusOutlierMask(const std::vector<Eigen::Vector3d>& points, double radius,
-                                       int min_neighbors) {
+                                       int min_neighbors, const std::string& method,
+                                       int threads) {
   std::vector<uint8_t> keep(points.size(), 1);
   if (points.empty() || radius <= 0 || min_neighbors <= 0) return keep;
+  if (method == "grid") {
+    const PointGrid grid(points, radius);
+    const double r2 = radius * radius;
+    grid.ForEachCell(threads, [&](const std::vector<int>& members, const std::vector<int>& cand) {
+      for (const int i : members) {
+        int count = -1;  // The point itself is a candidate.
+        for (const int j : cand) {
+          if ((points[j] - points[i]).squaredNorm() <= r2 && ++count >= min_neighbors) break;
+        }
+        keep[i] = count >= min_neighbors;
+      }
+    });
+    return keep;
+  }
+  JVL_CHECK(method == "pcl", "--outlier-method must be grid or pcl, got '" << method << "'");
   pcl::RadiusOutlierRemoval<pcl::PointXYZ> filter;
   filter.setInputCloud(ToPcl(points));
   filter.setRadiusSearch(radius);
@@ -160,10 +178,12 @@ std::vector<uint8_t> SmallObjectMask(const std::vector<Eigen::Vector3d>& points,
   // Connected components over the 26-neighbourhood of occupied cells.
   std::vector<int> parent(cells.size());
   std::iota(parent.begin(), parent.end(), 0);
+  // Adjacency is symmetric: only the 13 neighbours after the cell in (x, y, z) order are looked
+  // up.
   for (size_t a = 0; a < cells.size(); ++a) {
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dz = -1; dz <= 1; ++dz) {
+    for (int dx = 0; dx <= 1; ++dx) {
+      for (int dy = (dx == 0 ? 0 : -1); dy <= 1; ++dy) {
+        for (int dz = (dx == 0 && dy == 0 ? 1 : -1); dz <= 1; ++dz) {
           const Eigen::Vector3i& c = cells[a];
           const auto it = cell_id.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
           if (it == cell_id.end()) continue;
@@ -197,7 +217,7 @@ std::vector<uint8_t> SmallObjectMask(const std::vector<Eigen::Vector3d>& points,
 }
 
 PreprocessedScan PreprocessScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
-                                const PreprocessOptions& options) {
+                                const PreprocessOptions& options, int threads) {
   PreprocessedScan out;
   PreprocessCounts& counts = out.counts;
   counts.input = static_cast<int64_t>(velo_scan.size());
@@ -228,7 +248,8 @@ PreprocessedScan PreprocessScan(const PointCloud& velo_scan, const Rigid3d& cam0
   counts.after_voxel = static_cast<int64_t>(out.points.size());
 
   const std::vector<uint8_t> inlier =
-      RadiusOutlierMask(out.points, options.outlier_radius, options.outlier_min_neighbors);
+      RadiusOutlierMask(out.points, options.outlier_radius, options.outlier_min_neighbors,
+                        options.outlier_method, threads);
   Select(inlier, &out.points);
   Select(inlier, &out.time_fraction);
   counts.after_outliers = static_cast<int64_t>(out.points.size());

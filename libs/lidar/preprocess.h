@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "geometry/point_cloud.h"
@@ -28,11 +29,14 @@ struct PreprocessOptions {
   // PCL RadiusOutlierRemoval: keep points with at least min_neighbors others within radius.
   double outlier_radius = 1.0;
   int outlier_min_neighbors = 2;
+  // "grid": the same test answered from a hashed grid (several times faster, identical
+  // result); "pcl": pcl::RadiusOutlierRemoval itself.
+  std::string outlier_method = "grid";
   // PCL SACSegmentation (RANSAC, plane perpendicular to the cam0 y axis within max_angle).
   double ground_distance = 0.25;
   double ground_max_angle_deg = 15.0;
   int ground_max_iterations = 100;
-  int ground_max_samples = 8000;  // RANSAC runs on an evenly strided subset of this size.
+  int ground_max_samples = 4000;  // RANSAC runs on an evenly strided subset of this size.
   // Small-object removal: clusters of non-ground points connected through cells of this size,
   // dropped when their bounding box is below all three extents (IMLS-SLAM: 14 x 14 x 4 m).
   bool remove_small_objects = true;
@@ -60,7 +64,7 @@ struct PreprocessedScan {
 
 // The whole chain. Never throws on degenerate input: an empty result is valid data.
 PreprocessedScan PreprocessScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
-                                const PreprocessOptions& options);
+                                const PreprocessOptions& options, int threads = 1);
 
 // The single steps, exposed for tests and for the mapping stages. Each returns a keep mask or
 // labels over `points` (cam0 frame unless stated otherwise).
@@ -69,8 +73,10 @@ void CorrectVerticalAngle(double angle_rad, std::vector<Eigen::Vector3d>* velo_p
 // Time fraction in [-0.5, 0.5] of a velodyne-frame point from its azimuth: the HDL-64 spins
 // clockwise seen from above and KITTI stamps a scan when it faces forward (+x).
 float AzimuthTimeFraction(const Eigen::Vector3d& velo_point);
+// Keep mask of points with at least min_neighbors other points within radius.
 std::vector<uint8_t> RadiusOutlierMask(const std::vector<Eigen::Vector3d>& points, double radius,
-                                       int min_neighbors);
+                                       int min_neighbors, const std::string& method = "grid",
+                                       int threads = 1);
 // Ground inliers (1) by RANSAC; *plane receives the plane; returns all zeros if none found.
 std::vector<uint8_t> SegmentGround(const std::vector<Eigen::Vector3d>& points,
                                    const PreprocessOptions& options, Eigen::Vector4d* plane,

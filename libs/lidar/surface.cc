@@ -10,6 +10,35 @@
 #include "lidar/voxel_grid.h"
 
 namespace jvl::lidar {
+namespace {
+
+// Local PCA of point i's neighbourhood: normal = eigenvector of the smallest eigenvalue,
+// planarity a2D = (s2 - s3) / s1 (IMLS-SLAM Sec. V).
+void FitLocalPlane(const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<std::pair<double, int>>& nn, int i, ScanSurface* s) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& e : nn) mean += points[e.second];
+  mean /= static_cast<double>(nn.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& e : nn) {
+    const Eigen::Vector3d d = points[e.second] - mean;
+    cov += d * d.transpose();
+  }
+  cov /= static_cast<double>(nn.size());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  // Eigenvalues ascending: lambda3 <= lambda2 <= lambda1.
+  const Eigen::Vector3d l = eig.eigenvalues().cwiseMax(0.0);
+  const double s1 = std::sqrt(l[2]), s2 = std::sqrt(l[1]), s3 = std::sqrt(l[0]);
+  if (!(s1 > 0)) return;
+  Eigen::Vector3d n = eig.eigenvectors().col(0).normalized();
+  if (n.dot(points[i]) > 0) n = -n;  // Towards the sensor at the origin.
+  s->normals[i] = n;
+  s->planarity[i] = (s2 - s3) / s1;
+  s->valid[i] = 1;
+}
+
+}  // namespace
 
 void SurfaceOptions::Check() const {
   JVL_CHECK(normal_neighbors >= 3, "--normal-neighbors must be >= 3, got " << normal_neighbors);
@@ -28,34 +57,27 @@ ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
   s.valid.assign(points.size(), 0);
   if (points.empty()) return s;
   const PointGrid grid(points, options.normal_radius);
-  constexpr int64_t kChunk = 512;
-  const int64_t chunks = (static_cast<int64_t>(points.size()) + kChunk - 1) / kChunk;
-  ParallelFor(chunks, threads, [&](int64_t chunk) {
+  const double r2 = options.normal_radius * options.normal_radius;
+  const size_t k = static_cast<size_t>(options.normal_neighbors);
+  grid.ForEachCell(threads, [&](const std::vector<int>& members, const std::vector<int>& cand) {
+    // Candidate coordinates copied once per cell: the inner loop then streams through memory.
+    std::vector<Eigen::Vector3d> cp(cand.size());
+    for (size_t c = 0; c < cand.size(); ++c) cp[c] = points[cand[c]];
     std::vector<std::pair<double, int>> nn;
-    const size_t end = std::min(points.size(), static_cast<size_t>((chunk + 1) * kChunk));
-    for (size_t i = static_cast<size_t>(chunk * kChunk); i < end; ++i) {
-      grid.RadiusSearch(points[i], options.normal_radius,
-                        static_cast<size_t>(options.normal_neighbors), &nn);
-      if (static_cast<int>(nn.size()) < options.min_normal_neighbors) continue;
-      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-      for (const auto& [d2, j] : nn) mean += points[j];
-      mean /= static_cast<double>(nn.size());
-      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-      for (const auto& [d2, j] : nn) {
-        const Eigen::Vector3d d = points[j] - mean;
-        cov += d * d.transpose();
+    for (const int i : members) {
+      nn.clear();
+      const Eigen::Vector3d& p = points[i];
+      for (size_t c = 0; c < cp.size(); ++c) {
+        const double d2 = (cp[c] - p).squaredNorm();
+        if (d2 <= r2) nn.emplace_back(d2, cand[c]);
       }
-      cov /= static_cast<double>(nn.size());
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-      // Eigenvalues ascending: lambda3 <= lambda2 <= lambda1.
-      const Eigen::Vector3d l = eig.eigenvalues().cwiseMax(0.0);
-      const double s1 = std::sqrt(l[2]), s2 = std::sqrt(l[1]), s3 = std::sqrt(l[0]);
-      if (!(s1 > 0)) continue;
-      Eigen::Vector3d n = eig.eigenvectors().col(0);
-      if (n.dot(points[i]) > 0) n = -n;  // Towards the sensor at the origin.
-      s.normals[i] = n;
-      s.planarity[i] = (s2 - s3) / s1;
-      s.valid[i] = 1;
+      if (nn.size() < static_cast<size_t>(options.min_normal_neighbors)) continue;
+      // The k nearest, (distance, index) pairs are unique so the set is deterministic.
+      if (nn.size() > k) {
+        std::nth_element(nn.begin(), nn.begin() + static_cast<std::ptrdiff_t>(k), nn.end());
+        nn.resize(k);
+      }
+      FitLocalPlane(points, nn, i, &s);
     }
   });
   return s;
@@ -83,9 +105,15 @@ std::array<std::vector<int>, 9> SamplingLists(const ScanSurface& surface, size_t
     }
     lists[k] = valid;
     const size_t keep = max_length == 0 ? valid.size() : std::min(max_length, valid.size());
-    std::partial_sort(lists[k].begin(), lists[k].begin() + keep, lists[k].end(),
-                      [&](int a, int b) { return value[a] > value[b] || (value[a] == value[b] && a < b); });
-    lists[k].resize(keep);
+    if (keep == 0) continue;
+    const auto before = [&](int a, int b) {
+      return value[a] > value[b] || (value[a] == value[b] && a < b);
+    };
+    auto& list = lists[k];
+    std::nth_element(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(keep) - 1,
+                     list.end(), before);
+    list.resize(keep);
+    std::sort(list.begin(), list.end(), before);
   }
   return lists;
 }

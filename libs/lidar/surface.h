@@ -12,7 +12,7 @@ namespace jvl::lidar {
 
 struct SurfaceOptions {
   int normal_neighbors = 12;     // k nearest points used for the PCA.
-  double normal_radius = 1.5;    // m, neighbours further away are ignored.
+  double normal_radius = 1.0;    // m, neighbours further away are ignored.
   int min_normal_neighbors = 6;  // fewer -> no normal; the point is not used.
   void Check() const;
 };

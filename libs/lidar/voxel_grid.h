@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -52,6 +53,15 @@ class PointGrid {
   int CountWithin(const Eigen::Vector3d& q, double radius, int stop_at = 0) const;
   double cell_size() const { return cell_size_; }
 
+  // Batched queries: calls fn(members, candidates) once per occupied cell, where members are
+  // the indices of the points in the cell and candidates those in the 27 cells around it
+  // (itself included), so that every point within cell_size of a member is a candidate.
+  // Cells are split over `threads` threads; fn must only write to per-member slots.
+  void ForEachCell(int threads,
+                   const std::function<void(const std::vector<int>& members,
+                                            const std::vector<int>& candidates)>& fn) const;
+  size_t num_cells() const { return cell_keys_.size(); }
+
  private:
   template <typename Fn>
   void ForEachNear(const Eigen::Vector3d& q, Fn&& fn) const;
@@ -60,6 +70,7 @@ class PointGrid {
   double cell_size_, inv_cell_;
   std::vector<int> order_;  // Point indices sorted by cell.
   std::unordered_map<uint64_t, std::pair<int, int>, CellHash> cells_;  // key -> [begin, end)
+  std::vector<uint64_t> cell_keys_;  // Occupied cells in key order.
 };
 
 }  // namespace jvl::lidar

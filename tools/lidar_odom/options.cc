@@ -25,6 +25,8 @@ void AddOdometryOptions(CLI::App& cli, lidar::OdometryOptions& o) {
   add("--outlier-radius", p.outlier_radius, "RadiusOutlierRemoval radius (m, 0 = off)", pre);
   add("--outlier-min-neighbors", p.outlier_min_neighbors,
       "RadiusOutlierRemoval: minimum neighbours within the radius", pre);
+  add("--outlier-method", p.outlier_method,
+      "grid (hashed grid, same result) or pcl (pcl::RadiusOutlierRemoval)", pre);
   add("--ground-distance", p.ground_distance, "Ground plane inlier distance (m)", pre);
   add("--ground-max-angle", p.ground_max_angle_deg, "Ground normal vs vertical, max (deg)", pre);
   add("--ground-iterations", p.ground_max_iterations, "Ground RANSAC iterations", pre);
