@@ -60,12 +60,17 @@ std::vector<int64_t> ImlsModel::scan_ids() const {
   return ids;
 }
 
+int ImlsModel::Span(double radius) const {
+  return std::max(1, static_cast<int>(std::ceil(radius * inv_cell_ - 1e-9)));
+}
+
 bool ImlsModel::HasNeighbor(const Eigen::Vector3d& x, double radius) const {
   const double r2 = radius * radius;
   const Eigen::Vector3i c = CellOf(x, inv_cell_);
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
+  const int span = Span(radius);
+  for (int dx = -span; dx <= span; ++dx) {
+    for (int dy = -span; dy <= span; ++dy) {
+      for (int dz = -span; dz <= span; ++dz) {
         const auto it = cells_.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
         if (it == cells_.end()) continue;
         for (const Entry& e : it->second) {
@@ -89,9 +94,10 @@ bool ImlsModel::Project(const Eigen::Vector3d& x, double h, double radius,
   double sum_w = 0;
   Eigen::Vector3d sum_wd = Eigen::Vector3d::Zero();
   int count = 0;
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
+  const int span = Span(radius);
+  for (int dx = -span; dx <= span; ++dx) {
+    for (int dy = -span; dy <= span; ++dy) {
+      for (int dz = -span; dz <= span; ++dz) {
         const auto it = cells_.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
         if (it == cells_.end()) continue;
         for (const Entry& e : it->second) {

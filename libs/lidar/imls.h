@@ -30,7 +30,8 @@ struct ImlsProjection {
 
 class ImlsModel {
  public:
-  // cell_size must be >= every query radius (a query visits the 27 surrounding cells).
+  // Queries visit the 27 cells around x when radius <= cell_size (the common case; choose
+  // cell_size = the registration radius), more for larger radii.
   explicit ImlsModel(double cell_size);
 
   // Adds the world-frame points (with unit normals) of scan `scan_id`.
@@ -52,6 +53,7 @@ class ImlsModel {
   bool Project(const Eigen::Vector3d& x, double h, double radius, ImlsProjection* out) const;
 
  private:
+  int Span(double radius) const;  // Cells to visit on each side.
   struct Entry {
     Eigen::Vector3d point, normal;
     int64_t scan;

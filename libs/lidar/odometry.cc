@@ -22,6 +22,8 @@ void OdometryOptions::Check() const {
   registration.Check();
   JVL_CHECK(scan_map_size >= 1, "--scan-map-size must be >= 1, got " << scan_map_size);
   JVL_CHECK(samples_per_list >= 1, "--samples-per-list must be >= 1, got " << samples_per_list);
+  JVL_CHECK(initial_search_scale >= 1,
+            "--initial-search-scale must be >= 1, got " << initial_search_scale);
 }
 
 const char* ToString(FrameStatus status) {
@@ -51,6 +53,22 @@ Rigid3d Odometry::PredictMotion() const {
   const Rigid3d& a = frames_[frames_.size() - 2].world_from_cam;
   const Rigid3d& b = frames_.back().world_from_cam;
   return a.Inverse() * b;
+}
+
+RegistrationResult Odometry::Register(const ScanSurface& surface, const Rigid3d& predicted,
+                                      const RegistrationOptions& options, int* samples) const {
+  // IMLS-SLAM sampling: s points per list with a model neighbour within r at the prediction.
+  const auto lists =
+      SamplingLists(surface, kListLengthFactor * static_cast<size_t>(options_.samples_per_list));
+  const double r = options.search_radius;
+  const std::vector<int> picked =
+      SelectSamples(lists, surface.size(), options_.samples_per_list,
+                    [&](int i) { return model_.HasNeighbor(predicted * surface.points[i], r); });
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(picked.size());
+  for (const int i : picked) points.push_back(surface.points[i]);
+  *samples = static_cast<int>(points.size());
+  return RegisterScan(points, model_, predicted, options, threads_);
 }
 
 void Odometry::UpdateModel(int64_t frame, const ScanSurface& surface,
@@ -101,18 +119,23 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
     out.world_from_cam = Rigid3d();
   } else {
     const Rigid3d predicted = frames_.back().world_from_cam * motion;
-    const auto lists =
-        SamplingLists(surface, kListLengthFactor * static_cast<size_t>(options_.samples_per_list));
-    const double r = options_.registration.search_radius;
-    const std::vector<int> picked =
-        SelectSamples(lists, surface.size(), options_.samples_per_list,
-                      [&](int i) { return model_.HasNeighbor(predicted * surface.points[i], r); });
-    std::vector<Eigen::Vector3d> samples;
-    samples.reserve(picked.size());
-    for (const int i : picked) samples.push_back(surface.points[i]);
-    d.samples = static_cast<int>(samples.size());
-    const RegistrationResult reg =
-        RegisterScan(samples, model_, predicted, options_.registration, threads_);
+    Rigid3d start = predicted;
+    if (frames_.size() == 1 && options_.initial_search_scale > 1) {
+      // No velocity yet: a coarse registration with wider neighbourhoods seeds the normal one.
+      RegistrationOptions coarse = options_.registration;
+      const double k = options_.initial_search_scale;
+      coarse.search_radius *= k;
+      coarse.kernel_h *= k;
+      coarse.max_distance *= k;
+      coarse.robust_scale *= k;
+      const RegistrationResult first = Register(surface, predicted, coarse, &d.samples);
+      if (first.ok) start = first.world_from_scan;
+    }
+    RegistrationResult reg = Register(surface, start, options_.registration, &d.samples);
+    if (reg.degenerate && start.translation() != predicted.translation()) {
+      // Along unobservable directions the motion model, not the coarse pass, must be kept.
+      reg = Register(surface, predicted, options_.registration, &d.samples);
+    }
     out.world_from_cam = reg.world_from_scan;
     d.iterations = reg.iterations;
     d.residual = reg.residual;

@@ -28,6 +28,9 @@ struct OdometryOptions {
   int scan_map_size = 10;       // N: scans kept in the model.
   int samples_per_list = 100;   // s of IMLS-SLAM (9 lists -> up to 900 points).
   bool deskew = false;          // Constant-velocity de-skewing from the point azimuths.
+  // Second scan (no motion estimate yet): a coarse registration first runs with the search
+  // radius, kernel h, max distance and robust scale multiplied by this (1 = off).
+  double initial_search_scale = 4.0;
   void Check() const;
 };
 
@@ -75,6 +78,8 @@ class Odometry {
 
  private:
   Rigid3d PredictMotion() const;  // prev_from_cur of the constant-velocity model.
+  RegistrationResult Register(const ScanSurface& surface, const Rigid3d& predicted,
+                              const RegistrationOptions& options, int* samples) const;
   void UpdateModel(int64_t frame, const ScanSurface& surface, const Rigid3d& world_from_cam);
 
   Rigid3d cam0_from_velo_;

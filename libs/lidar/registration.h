@@ -27,7 +27,7 @@ struct RegistrationOptions {
   double convergence_translation = 1e-4;  // m per iteration.
   double convergence_rotation = 1e-5;     // rad per iteration.
   int min_correspondences = 30;           // fewer: no update, result.ok = false.
-  double degeneracy_threshold = 2e-3;     // on the normalised eigenvalues.
+  double degeneracy_threshold = 5e-3;     // On the normalised eigenvalues.
   void Check() const;
 };
 

@@ -11,6 +11,8 @@ void AddOdometryOptions(CLI::App& cli, lidar::OdometryOptions& o) {
   add("--scan-map-size", o.scan_map_size, "N: scans kept in the model (paper's N)", model);
   add("--samples-per-list", o.samples_per_list, "s: points per IMLS-SLAM sampling list (x9)",
       model);
+  add("--initial-search-scale", o.initial_search_scale,
+      "Second scan (no velocity yet): coarse pass with neighbourhoods x this (1 = off)", model);
   cli.add_flag("--deskew,!--no-deskew", o.deskew, "Constant-velocity de-skewing of each scan")
       ->capture_default_str()
       ->group(model);
