@@ -65,10 +65,14 @@ RegistrationResult Odometry::Register(const ScanSurface& surface, const Rigid3d&
       SelectSamples(lists, surface.size(), options_.samples_per_list,
                     [&](int i) { return model_.HasNeighbor(predicted * surface.points[i], r); });
   std::vector<Eigen::Vector3d> points;
+  std::vector<double> planarity;
   points.reserve(picked.size());
-  for (const int i : picked) points.push_back(surface.points[i]);
+  for (const int i : picked) {
+    points.push_back(surface.points[i]);
+    planarity.push_back(surface.planarity[i]);
+  }
   *samples = static_cast<int>(points.size());
-  return RegisterScan(points, model_, predicted, options, threads_);
+  return RegisterScan(points, model_, predicted, options, threads_, &planarity);
 }
 
 void Odometry::UpdateModel(int64_t frame, const ScanSurface& surface,

@@ -36,7 +36,7 @@ struct PreprocessOptions {
   double ground_distance = 0.25;
   double ground_max_angle_deg = 15.0;
   int ground_max_iterations = 100;
-  int ground_max_samples = 4000;  // RANSAC runs on an evenly strided subset of this size.
+  int ground_max_samples = 2000;  // RANSAC runs on an evenly strided subset of this size.
   // Small-object removal: clusters of non-ground points connected through cells of this size,
   // dropped when their bounding box is below all three extents (IMLS-SLAM: 14 x 14 x 4 m).
   bool remove_small_objects = true;

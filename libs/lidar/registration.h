@@ -4,7 +4,8 @@
 // convergence thresholds or the iteration cap is reached.
 //
 // Degeneracy: the 6x6 normal matrix (rotation columns scaled by the mean sample range so both
-// blocks are unitless, divided by the total weight) is eigen-decomposed; directions whose
+// blocks are unitless, each point weighted by its planarity a2D^2, divided by the total
+// weight) is eigen-decomposed; directions whose
 // eigenvalue is below `degeneracy_threshold` are unobservable (a corridor along its axis). The
 // update is then restricted to the observable directions, so the pose keeps the initial guess
 // (the constant-velocity motion model) along the degenerate ones, and the result is flagged.
@@ -27,7 +28,7 @@ struct RegistrationOptions {
   double convergence_translation = 1e-4;  // m per iteration.
   double convergence_rotation = 1e-5;     // rad per iteration.
   int min_correspondences = 30;           // fewer: no update, result.ok = false.
-  double degeneracy_threshold = 5e-3;     // On the normalised eigenvalues.
+  double degeneracy_threshold = 2e-3;     // On the normalised eigenvalues.
   void Check() const;
 };
 
@@ -44,8 +45,10 @@ struct RegistrationResult {
 };
 
 // points: sampled scan points in the scan frame. initial: predicted world_from_scan.
+// planarity (optional, a2D per point) weights the observability test by a2D^2.
 RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
                                 const ImlsModel& model, const Rigid3d& initial,
-                                const RegistrationOptions& options, int threads);
+                                const RegistrationOptions& options, int threads,
+                                const std::vector<double>* planarity = nullptr);
 
 }  // namespace jvl::lidar
