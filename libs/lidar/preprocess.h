@@ -25,7 +25,7 @@ struct PreprocessOptions {
   double vertical_correction_deg = 0.0;
   // Voxel downsampling (m) applied after the range cut; all later steps and the model use the
   // downsampled points. 0 = keep every point.
-  double voxel_size = 0.3;
+  double voxel_size = 0.4;
   // PCL RadiusOutlierRemoval: keep points with at least min_neighbors others within radius.
   double outlier_radius = 1.0;
   int outlier_min_neighbors = 2;

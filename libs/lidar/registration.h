@@ -25,8 +25,8 @@ struct RegistrationOptions {
   double search_radius = 0.6;             // m, r: model neighbours of Eq. (2).
   double max_distance = 0.5;              // m, |I(x)| above this: no correspondence.
   double robust_scale = 0.1;              // m, Cauchy scale on I(x).
-  double convergence_translation = 1e-4;  // m per iteration.
-  double convergence_rotation = 1e-5;     // rad per iteration.
+  double convergence_translation = 5e-4;  // m per iteration.
+  double convergence_rotation = 5e-5;     // rad per iteration.
   int min_correspondences = 30;           // fewer: no update, result.ok = false.
   double degeneracy_threshold = 2e-3;     // On the normalised eigenvalues.
   void Check() const;
