@@ -56,13 +56,13 @@ Rigid3d Odometry::PredictMotion() const {
 }
 
 RegistrationResult Odometry::Register(const ScanSurface& surface, const Rigid3d& predicted,
-                                      const RegistrationOptions& options, int* samples) const {
+                                      const RegistrationOptions& options, int per_list,
+                                      int* samples) const {
   // IMLS-SLAM sampling: s points per list with a model neighbour within r at the prediction.
-  const auto lists =
-      SamplingLists(surface, kListLengthFactor * static_cast<size_t>(options_.samples_per_list));
+  const auto lists = SamplingLists(surface, kListLengthFactor * static_cast<size_t>(per_list));
   const double r = options.search_radius;
   const std::vector<int> picked =
-      SelectSamples(lists, surface.size(), options_.samples_per_list,
+      SelectSamples(lists, surface.size(), per_list,
                     [&](int i) { return model_.HasNeighbor(predicted * surface.points[i], r); });
   std::vector<Eigen::Vector3d> points;
   std::vector<double> planarity;
@@ -132,13 +132,16 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
       coarse.kernel_h *= k;
       coarse.max_distance *= k;
       coarse.robust_scale *= k;
-      const RegistrationResult first = Register(surface, predicted, coarse, &d.samples);
+      // A quarter of the samples: the wide neighbourhoods make each query ~20x dearer.
+      const RegistrationResult first = Register(
+          surface, predicted, coarse, std::max(1, options_.samples_per_list / 4), &d.samples);
       if (first.ok) start = first.world_from_scan;
     }
-    RegistrationResult reg = Register(surface, start, options_.registration, &d.samples);
+    const int s = options_.samples_per_list;
+    RegistrationResult reg = Register(surface, start, options_.registration, s, &d.samples);
     if (reg.degenerate && start.translation() != predicted.translation()) {
       // Along unobservable directions the motion model, not the coarse pass, must be kept.
-      reg = Register(surface, predicted, options_.registration, &d.samples);
+      reg = Register(surface, predicted, options_.registration, s, &d.samples);
     }
     out.world_from_cam = reg.world_from_scan;
     d.iterations = reg.iterations;

@@ -79,7 +79,8 @@ class Odometry {
  private:
   Rigid3d PredictMotion() const;  // prev_from_cur of the constant-velocity model.
   RegistrationResult Register(const ScanSurface& surface, const Rigid3d& predicted,
-                              const RegistrationOptions& options, int* samples) const;
+                              const RegistrationOptions& options, int per_list,
+                              int* samples) const;
   void UpdateModel(int64_t frame, const ScanSurface& surface, const Rigid3d& world_from_cam);
 
   Rigid3d cam0_from_velo_;
