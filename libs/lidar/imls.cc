@@ -32,8 +32,8 @@ void ImlsModel::AddScan(int64_t scan_id, const std::vector<Eigen::Vector3d>& wor
 }
 
 void ImlsModel::RemoveScan(int64_t scan_id) {
-  const auto it = std::find_if(scans_.begin(), scans_.end(),
-                               [&](const auto& s) { return s.first == scan_id; });
+  const auto it =
+      std::find_if(scans_.begin(), scans_.end(), [&](const auto& s) { return s.first == scan_id; });
   if (it == scans_.end()) return;
   for (const uint64_t key : it->second) {
     const auto cell = cells_.find(key);
@@ -123,9 +123,9 @@ bool ImlsModel::Project(const Eigen::Vector3d& x, double h, double radius,
   out->neighbors = count;
   // Far from every point relative to h all weights underflow: the nearest point alone
   // defines the surface (the limit of Eq. 2 as h -> 0).
-  const Eigen::Vector3d mean_d =
-      sum_w > std::numeric_limits<double>::min() ? Eigen::Vector3d(sum_wd / sum_w)
-                                                 : Eigen::Vector3d(x - out->nearest);
+  const Eigen::Vector3d mean_d = sum_w > std::numeric_limits<double>::min()
+                                     ? Eigen::Vector3d(sum_wd / sum_w)
+                                     : Eigen::Vector3d(x - out->nearest);
   out->distance = mean_d.dot(out->normal);
   out->projection = x - out->distance * out->normal;
   return true;

@@ -88,7 +88,7 @@ TEST(SurfaceTest, NormalsAndPlanarityOfAPlaneAndALine) {
   for (size_t i = 0; i < n_plane; ++i) {
     ASSERT_TRUE(s.valid[i]);
     EXPECT_NEAR(s.normals[i].y(), -1.0, 1e-9);  // Towards the sensor (up is -y).
-    EXPECT_GT(s.planarity[i], 0.5);  // 1 inside the patch, lower at its border.
+    EXPECT_GT(s.planarity[i], 0.5);             // 1 inside the patch, lower at its border.
   }
   for (size_t i = n_plane; i < pts.size(); ++i) {
     if (s.valid[i]) {

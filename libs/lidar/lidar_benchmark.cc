@@ -23,8 +23,8 @@ using jvl::lidar::PointGrid;
 
 const std::vector<Eigen::Vector3d>& Points() {
   static const std::vector<Eigen::Vector3d> points = [] {
-    const std::string seq = std::string(JVL_SOURCE_DIR) +
-                            "/../shared/data/kitti_odometry_04_f0-50/sequences/04";
+    const std::string seq =
+        std::string(JVL_SOURCE_DIR) + "/../shared/data/kitti_odometry_04_f0-50/sequences/04";
     std::vector<Eigen::Vector3d> raw;
     if (std::filesystem::exists(seq)) {
       const auto dataset = jvl::io::OpenDataset(seq);

@@ -61,9 +61,9 @@ RegistrationResult Odometry::Register(const ScanSurface& surface, const Rigid3d&
   // IMLS-SLAM sampling: s points per list with a model neighbour within r at the prediction.
   const auto lists = SamplingLists(surface, kListLengthFactor * static_cast<size_t>(per_list));
   const double r = options.search_radius;
-  const std::vector<int> picked =
-      SelectSamples(lists, surface.size(), per_list,
-                    [&](int i) { return model_.HasNeighbor(predicted * surface.points[i], r); });
+  const std::vector<int> picked = SelectSamples(lists, surface.size(), per_list, [&](int i) {
+    return model_.HasNeighbor(predicted * surface.points[i], r);
+  });
   std::vector<Eigen::Vector3d> points;
   std::vector<double> planarity;
   points.reserve(picked.size());
@@ -152,15 +152,17 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
     if (!reg.ok) {
       d.status = FrameStatus::kMotionModel;
       d.degenerate = true;
-      spdlog::warn("frame {}: {} points after filtering, {} correspondences: using the "
-                   "constant-velocity motion model",
-                   frame, d.points_after_filter, reg.correspondences);
+      spdlog::warn(
+          "frame {}: {} points after filtering, {} correspondences: using the "
+          "constant-velocity motion model",
+          frame, d.points_after_filter, reg.correspondences);
     } else if (reg.degenerate) {
       d.status = FrameStatus::kDegenerate;
       d.degenerate = true;
-      spdlog::warn("frame {}: degenerate geometry ({} unobservable directions, min eigenvalue "
-                   "{:.2e}): motion model kept along them",
-                   frame, reg.degenerate_directions, reg.min_eigenvalue);
+      spdlog::warn(
+          "frame {}: degenerate geometry ({} unobservable directions, min eigenvalue "
+          "{:.2e}): motion model kept along them",
+          frame, reg.degenerate_directions, reg.min_eigenvalue);
     }
   }
   d.register_ms = timer.ElapsedMs() - d.preprocess_ms - d.surface_ms;

@@ -36,8 +36,8 @@ RunSummary RunKitti(const std::string& frames, const OdometryOptions& options) {
   const std::clock_t cpu0 = std::clock();
   double iterations = 0;
   for (size_t k = 0; k < dataset->frames().size(); ++k) {
-    const OdometryFrame f = odometry.ProcessScan(dataset->LoadScan(dataset->frames()[k]),
-                                                 dataset->frames()[k]);
+    const OdometryFrame f =
+        odometry.ProcessScan(dataset->LoadScan(dataset->frames()[k]), dataset->frames()[k]);
     est.push_back(f.world_from_cam.Matrix4());
     gt.push_back(dataset->ground_truth()->world_from_cam[k].Matrix4());
     ms.push_back(f.diagnostics.time_ms);
@@ -45,23 +45,26 @@ RunSummary RunKitti(const std::string& frames, const OdometryOptions& options) {
     iterations += f.diagnostics.iterations;
     if (std::getenv("JVL_LIDAR_VERBOSE")) {
       const FrameDiagnostics& d = f.diagnostics;
-      std::printf("frame %lld: %lld pts, pre %.1f surf %.1f reg %.1f total %.1f ms, %d samples, %d it, "
-                  "%d corr, res %.4f, eig %.4f\n",
-                  static_cast<long long>(f.frame), static_cast<long long>(d.points_after_filter),
-                  d.preprocess_ms, d.surface_ms, d.register_ms, d.time_ms, d.samples, d.iterations,
-                  d.correspondences, d.residual, d.min_eigenvalue);
+      std::printf(
+          "frame %lld: %lld pts, pre %.1f surf %.1f reg %.1f total %.1f ms, %d samples, %d it, "
+          "%d corr, res %.4f, eig %.4f\n",
+          static_cast<long long>(f.frame), static_cast<long long>(d.points_after_filter),
+          d.preprocess_ms, d.surface_ms, d.register_ms, d.time_ms, d.samples, d.iterations,
+          d.correspondences, d.residual, d.min_eigenvalue);
     }
   }
   const double cpu_ms = 1e3 * static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
-  std::printf("CPU time %.1f ms per frame (incl. loading)\n", cpu_ms / static_cast<double>(ms.size()));
+  std::printf("CPU time %.1f ms per frame (incl. loading)\n",
+              cpu_ms / static_cast<double>(ms.size()));
   std::sort(ms.begin(), ms.end());
   s.median_ms = ms[ms.size() / 2];
   s.errors = testing::ComputeErrors(est, gt);
   std::printf("iterations %.2f mean\n", iterations / static_cast<double>(ms.size()));
-  std::printf("KITTI 04 frames %s: APE %.4f m, end drift %.4f m over %.2f m (%.3f %%), "
-              "median %.1f ms/scan, %d flagged\n",
-              frames.c_str(), s.errors.ape_rmse, s.errors.end_drift, s.errors.distance,
-              100 * s.errors.drift_fraction(), s.median_ms, s.flagged);
+  std::printf(
+      "KITTI 04 frames %s: APE %.4f m, end drift %.4f m over %.2f m (%.3f %%), "
+      "median %.1f ms/scan, %d flagged\n",
+      frames.c_str(), s.errors.ape_rmse, s.errors.end_drift, s.errors.distance,
+      100 * s.errors.drift_fraction(), s.median_ms, s.flagged);
   return s;
 }
 

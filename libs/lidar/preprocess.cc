@@ -53,9 +53,9 @@ void PreprocessOptions::Check() const {
   JVL_CHECK(min_range >= 0, "--min-range must be >= 0, got " << min_range);
   JVL_CHECK(max_range == 0 || max_range > min_range,
             "--max-range must be 0 or > --min-range, got " << max_range);
-  JVL_CHECK(std::abs(vertical_correction_deg) < 5,
-            "--vertical-correction must be a small angle in degrees, got "
-                << vertical_correction_deg);
+  JVL_CHECK(
+      std::abs(vertical_correction_deg) < 5,
+      "--vertical-correction must be a small angle in degrees, got " << vertical_correction_deg);
   JVL_CHECK(voxel_size >= 0, "--voxel-size must be >= 0, got " << voxel_size);
   JVL_CHECK(outlier_radius >= 0, "--outlier-radius must be >= 0, got " << outlier_radius);
   JVL_CHECK(outlier_method == "grid" || outlier_method == "pcl",
@@ -89,8 +89,7 @@ float AzimuthTimeFraction(const Eigen::Vector3d& velo_point) {
 }
 
 std::vector<uint8_t> RadiusOutlierMask(const std::vector<Eigen::Vector3d>& points, double radius,
-                                       int min_neighbors, const std::string& method,
-                                       int threads) {
+                                       int min_neighbors, const std::string& method, int threads) {
   std::vector<uint8_t> keep(points.size(), 1);
   if (points.empty() || radius <= 0 || min_neighbors <= 0) return keep;
   if (method == "grid") {

@@ -19,8 +19,8 @@
 namespace jvl::lidar {
 
 struct PreprocessOptions {
-  double min_range = 5.0;    // m, supplement 1.1.
-  double max_range = 0.0;    // m, 0 = no limit.
+  double min_range = 5.0;  // m, supplement 1.1.
+  double max_range = 0.0;  // m, 0 = no limit.
   // KITTI HDL-64 intrinsic elevation error (degrees, e.g. 0.205); 0 = off.
   double vertical_correction_deg = 0.0;
   // Voxel downsampling (m) applied after the range cut; all later steps and the model use the

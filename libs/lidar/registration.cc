@@ -54,13 +54,11 @@ void RegistrationOptions::Check() const {
             "--degeneracy-threshold must be >= 0, got " << degeneracy_threshold);
 }
 
-RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
-                                const ImlsModel& model, const Rigid3d& initial,
-                                const RegistrationOptions& options, int threads,
-                                const std::vector<double>* planarity) {
+RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, const ImlsModel& model,
+                                const Rigid3d& initial, const RegistrationOptions& options,
+                                int threads, const std::vector<double>* planarity) {
   JVL_CHECK(planarity == nullptr || planarity->size() == points.size(),
-            "planarity has " << planarity->size() << " entries for " << points.size()
-                             << " points");
+            "planarity has " << planarity->size() << " entries for " << points.size() << " points");
   RegistrationResult result;
   result.world_from_scan = initial;
   // Characteristic length that makes rotation columns comparable to translation ones.

@@ -37,18 +37,17 @@ struct RegistrationResult {
   bool ok = false;         // Enough correspondences for an estimate.
   bool converged = false;  // Stopped on the thresholds, not on the iteration cap.
   int iterations = 0;
-  int correspondences = 0;       // At the last iteration.
-  double residual = 0;           // RMS of I(x) over the correspondences, m.
-  bool degenerate = false;       // Some direction fell back to the initial guess.
+  int correspondences = 0;  // At the last iteration.
+  double residual = 0;      // RMS of I(x) over the correspondences, m.
+  bool degenerate = false;  // Some direction fell back to the initial guess.
   int degenerate_directions = 0;
-  double min_eigenvalue = 0;     // Smallest normalised eigenvalue (last iteration).
+  double min_eigenvalue = 0;  // Smallest normalised eigenvalue (last iteration).
 };
 
 // points: sampled scan points in the scan frame. initial: predicted world_from_scan.
 // planarity (optional, a2D per point) weights the observability test by a2D^2.
-RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
-                                const ImlsModel& model, const Rigid3d& initial,
-                                const RegistrationOptions& options, int threads,
-                                const std::vector<double>* planarity = nullptr);
+RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, const ImlsModel& model,
+                                const Rigid3d& initial, const RegistrationOptions& options,
+                                int threads, const std::vector<double>* planarity = nullptr);
 
 }  // namespace jvl::lidar

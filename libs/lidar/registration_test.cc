@@ -24,8 +24,7 @@ void BuildModel(const std::vector<Eigen::Vector3d>& world, ImlsModel* model) {
 // IMLS-SLAM sampling of the scan (scan frame), accepting every point.
 std::vector<Eigen::Vector3d> Sample(const std::vector<Eigen::Vector3d>& scan) {
   const ScanSurface s = ComputeSurface(scan, SurfaceOptions(), 2);
-  const auto picked =
-      SelectSamples(SamplingLists(s), s.size(), 100, [](int) { return true; });
+  const auto picked = SelectSamples(SamplingLists(s), s.size(), 100, [](int) { return true; });
   std::vector<Eigen::Vector3d> out;
   for (const int i : picked) out.push_back(scan[i]);
   return out;

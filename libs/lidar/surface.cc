@@ -43,9 +43,9 @@ void FitLocalPlane(const std::vector<Eigen::Vector3d>& points,
 void SurfaceOptions::Check() const {
   JVL_CHECK(normal_neighbors >= 3, "--normal-neighbors must be >= 3, got " << normal_neighbors);
   JVL_CHECK(normal_radius > 0, "--normal-radius must be > 0, got " << normal_radius);
-  JVL_CHECK(min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
-            "--min-normal-neighbors must be in [3, --normal-neighbors], got "
-                << min_normal_neighbors);
+  JVL_CHECK(
+      min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
+      "--min-normal-neighbors must be in [3, --normal-neighbors], got " << min_normal_neighbors);
 }
 
 ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
@@ -113,8 +113,8 @@ std::array<std::vector<int>, 9> SamplingLists(const ScanSurface& surface, size_t
       return value[a] > value[b] || (value[a] == value[b] && a < b);
     };
     auto& list = lists[k];
-    std::nth_element(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(keep) - 1,
-                     list.end(), before);
+    std::nth_element(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(keep) - 1, list.end(),
+                     before);
     list.resize(keep);
     std::sort(list.begin(), list.end(), before);
   }

@@ -33,8 +33,7 @@ int CellMap::Insert(uint64_t key, int value) {
   return value;
 }
 
-std::vector<size_t> VoxelDownsample(const std::vector<Eigen::Vector3d>& points,
-                                    double voxel_size) {
+std::vector<size_t> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, double voxel_size) {
   std::vector<size_t> kept;
   if (voxel_size <= 0) {
     kept.resize(points.size());

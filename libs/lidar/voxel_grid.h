@@ -98,8 +98,8 @@ class PointGrid {
 
   const std::vector<Eigen::Vector3d>& points_;
   double cell_size_, inv_cell_;
-  std::vector<int> order_;  // Point indices sorted by cell.
-  CellMap cells_;           // key -> index into cell_keys_ / cell_begin_.
+  std::vector<int> order_;           // Point indices sorted by cell.
+  CellMap cells_;                    // key -> index into cell_keys_ / cell_begin_.
   std::vector<uint64_t> cell_keys_;  // Occupied cells in key order.
   std::vector<int> cell_begin_;      // Range of cell c in order_: [begin[c], begin[c + 1]).
 };

@@ -77,11 +77,12 @@ int main(int argc, char** argv) {
     const double cpu_ms = 1e3 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
     const auto& d = artifact.diagnostics;
     const auto flagged = std::count(d.degenerate.begin(), d.degenerate.end(), 1);
-    spdlog::info("{} frames; per scan {:.1f} ms median, {:.1f} ms p95, {:.1f} ms max wall, "
-                 "{:.1f} ms CPU mean; {} flagged; {} threads; peak memory {:.0f} MiB",
-                 ids.size(), Percentile(d.time_ms, 0.5), Percentile(d.time_ms, 0.95),
-                 Percentile(d.time_ms, 1.0), cpu_ms / std::max<double>(1.0, ids.size()), flagged,
-                 tool.threads(), static_cast<double>(jvl::PeakMemoryBytes()) / (1 << 20));
+    spdlog::info(
+        "{} frames; per scan {:.1f} ms median, {:.1f} ms p95, {:.1f} ms max wall, "
+        "{:.1f} ms CPU mean; {} flagged; {} threads; peak memory {:.0f} MiB",
+        ids.size(), Percentile(d.time_ms, 0.5), Percentile(d.time_ms, 0.95),
+        Percentile(d.time_ms, 1.0), cpu_ms / std::max<double>(1.0, ids.size()), flagged,
+        tool.threads(), static_cast<double>(jvl::PeakMemoryBytes()) / (1 << 20));
     jvl::io::WriteOdometryArtifact(output, artifact, tool.MakeProvenance());
     if (!kitti_poses.empty()) jvl::io::WriteTrajectoryKitti(kitti_poses, artifact.trajectory);
   });
