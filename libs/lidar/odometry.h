@@ -78,6 +78,9 @@ class Odometry {
 
  private:
   Rigid3d PredictMotion() const;  // prev_from_cur of the constant-velocity model.
+  // Registration from the prediction, with the coarse pass of the second scan.
+  RegistrationResult Track(const ScanSurface& surface, const Rigid3d& predicted,
+                           int* samples) const;
   RegistrationResult Register(const ScanSurface& surface, const Rigid3d& predicted,
                               const RegistrationOptions& options, int per_list, int* samples) const;
   void UpdateModel(int64_t frame, const ScanSurface& surface, const Rigid3d& world_from_cam);

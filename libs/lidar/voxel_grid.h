@@ -7,7 +7,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
