@@ -47,6 +47,7 @@ void GlobalMappingOptions::Check() const {
   joint.Check();
   solve.Check();
   traversal.Check();
+  JVL_CHECK(rounds >= 1, "rounds must be >= 1, got " << rounds);
 }
 
 DirectionSelection SelectDirections(const Trajectory& keyframes,
@@ -166,35 +167,48 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   GlobalMappingResult result;
   optim::JointProblemInput problem;
   problem.camera = input.camera;
-  for (size_t i = 0; i < input.keyframes.size(); ++i)
-    problem.poses[static_cast<int64_t>(i)] = input.keyframes.world_from_cam[i];
   problem.fixed = {0};  // gauge: the first keyframe
   problem.map_points = input.map_points;
   problem.observations = input.observations;
-  if (options.use_saved_imls) problem.imls = input.saved_imls;
-  result.saved_imls = static_cast<int64_t>(problem.imls.size());
-  if (options.fresh_traversal && !input.scans.empty()) {
-    const Timer t;
-    const auto fresh =
-        TraverseImls(input.keyframes, input.scans, options.traversal, options.solve.threads);
-    problem.imls.insert(problem.imls.end(), fresh.begin(), fresh.end());
-    result.fresh_imls = static_cast<int64_t>(fresh.size());
-    result.traversal_time_s = t.ElapsedSeconds();
-  }
   const DirectionSelection dirs = SelectDirections(input.keyframes, input.directions);
   result.directions_not_keyframe = dirs.not_keyframe;
   result.directions_at_infinity = dirs.at_infinity;
   if (options.use_directions) problem.directions = dirs.constraints;
   result.directions_used = static_cast<int64_t>(problem.directions.size());
-  result.solve = optim::OptimizeJoint(problem, options.joint, options.solve);
   result.keyframes = input.keyframes;
-  if (result.solve.usable) {
-    for (size_t i = 0; i < input.keyframes.size(); ++i)
+  const bool fresh = options.fresh_traversal && !input.scans.empty();
+  const int rounds = fresh ? options.rounds : 1;
+  optim::JointCostBreakdown first_before;
+  for (int round = 0; round < rounds; ++round) {
+    for (size_t i = 0; i < result.keyframes.size(); ++i)
+      problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
+    problem.imls.clear();
+    if (options.use_saved_imls) problem.imls = input.saved_imls;
+    result.saved_imls = static_cast<int64_t>(problem.imls.size());
+    if (fresh) {
+      // Eq. (3) against the current poses (the paper's single traversal in round 0).
+      const Timer t;
+      const auto l =
+          TraverseImls(result.keyframes, input.scans, options.traversal, options.solve.threads);
+      problem.imls.insert(problem.imls.end(), l.begin(), l.end());
+      result.fresh_imls = static_cast<int64_t>(l.size());
+      result.traversal_time_s += t.ElapsedSeconds();
+    }
+    result.solve = optim::OptimizeJoint(problem, options.joint, options.solve);
+    ++result.rounds;
+    result.total_iterations += result.solve.iterations;
+    if (round == 0) first_before = result.solve.before;
+    if (!result.solve.usable) {
+      spdlog::warn("global optimisation round {} failed ({}); keyframes keep the poses of the "
+                   "previous round",
+                   round, result.solve.termination);
+      break;
+    }
+    for (size_t i = 0; i < result.keyframes.size(); ++i)
       result.keyframes.world_from_cam[i] = result.solve.poses.at(static_cast<int64_t>(i));
-  } else {
-    spdlog::warn("global optimisation failed ({}); keyframes keep their input poses",
-                 result.solve.termination);
+    problem.map_points = result.solve.map_points;
   }
+  result.solve.before = first_before;  // report the costs at the input poses
   result.total_time_s = total.ElapsedSeconds();
   return result;
 }
@@ -226,7 +240,8 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
                           {"not_keyframe", r.directions_not_keyframe},
                           {"at_infinity", r.directions_at_infinity},
                           {"enabled", o.use_directions}}},
-          {"solver", {{"usable", s.usable}, {"iterations", s.iterations},
+          {"solver", {{"usable", s.usable}, {"iterations", r.total_iterations},
+                      {"rounds", r.rounds}, {"last_round_iterations", s.iterations},
                       {"time_s", s.time_s}, {"termination", s.termination},
                       {"linear_solver", s.linear_solver}, {"threads", o.solve.threads},
                       {"max_iterations", o.solve.max_iterations}}},

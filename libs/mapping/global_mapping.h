@@ -68,6 +68,9 @@ struct GlobalMappingOptions {
   bool use_directions = true;    // false: the --no-direction ablation.
   bool use_saved_imls = true;    // the set L of local mapping
   bool fresh_traversal = true;   // the fresh Eq. (3) traversal of all keyframes
+  // Rounds of (fresh traversal at the current poses, LM solve); round r > 0 starts from round
+  // r - 1's poses and map points. 1 = the paper's single pass.
+  int rounds = 2;
   void Check() const;
 };
 
@@ -84,6 +87,8 @@ struct GlobalMappingResult {
   int64_t directions_used = 0, directions_not_keyframe = 0, directions_at_infinity = 0;
   double traversal_time_s = 0;
   double total_time_s = 0;
+  int rounds = 0;
+  int total_iterations = 0;  // LM iterations over all rounds (solve.iterations: last round)
 };
 
 // Direction residual inputs: one per keyframe with an association and a finite VP.

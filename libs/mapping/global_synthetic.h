@@ -31,6 +31,12 @@ struct SyntheticGlobalOptions {
   double scan_spacing = 1.0;                // m grid of the sampled surfaces
   int map_points_per_keyframe = 30;
   uint32_t seed = 7;
+  // true: the biased-odometry model above (local terms consistent with the prior). false: a
+  // physically consistent world: scans and keypoints measured from the true poses in the true
+  // (straight) world with `range_noise` / 0.5 px noise; map points start where the prior
+  // would triangulate them. The drift is then visible to the local terms too.
+  bool biased_local = true;
+  double range_noise = 0.01;  // m
 };
 
 struct SyntheticGlobal {
@@ -80,7 +86,7 @@ inline void AddScanPoint(const std::vector<Rigid3d>& prior_kf, double step, cons
 
 inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
   std::mt19937 rng(o.seed);
-  std::normal_distribution<double> pixel(0.0, 0.5), range(0.0, 0.01);
+  std::normal_distribution<double> pixel(0.0, 0.5), range(0.0, o.range_noise);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   SyntheticGlobal out;
   GlobalMapInput& in = out.input;
@@ -106,17 +112,19 @@ inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
                      0.1 * static_cast<double>(f));
   }
   const double sp = o.scan_spacing;
+  // The world the sensors measure, and where the sensors are.
+  const std::vector<Rigid3d>& world = o.biased_local ? prior_kf : out.truth_keyframes;
   for (int k = 0; k < o.keyframes; ++k) {
-    const Rigid3d cam_from_world = prior_kf[k].Inverse();
+    const Rigid3d cam_from_world = world[k].Inverse();
     const double s0 = o.step * k;
     KeyframeScan scan;
     for (double s = s0 - o.scan_range; s <= s0 + o.scan_range; s += sp) {
       for (double x = -7.5; x <= 7.5; x += sp)  // ground
-        AddScanPoint(prior_kf, o.step, cam_from_world, {x + 0.3 * u(rng), 1.7, s + 0.3 * u(rng)},
+        AddScanPoint(world, o.step, cam_from_world, {x + 0.3 * u(rng), 1.7, s + 0.3 * u(rng)},
                      -Eigen::Vector3d::UnitY(), range(rng), &scan);
       for (double y = -3.0; y <= 1.5; y += sp)  // walls
         for (double side : {-1.0, 1.0})
-          AddScanPoint(prior_kf, o.step, cam_from_world, {8.0 * side, y + 0.3 * u(rng), s + 0.3 * u(rng)},
+          AddScanPoint(world, o.step, cam_from_world, {8.0 * side, y + 0.3 * u(rng), s + 0.3 * u(rng)},
                        Eigen::Vector3d(-side, 0, 0), range(rng), &scan);
     }
     for (double s = 15.0 * std::floor((s0 - o.scan_range) / 15.0); s <= s0 + o.scan_range;
@@ -125,7 +133,7 @@ inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
         for (double y = -2.0; y <= 1.5; y += 0.5)
           for (int a = 0; a < 8; ++a) {
             const Eigen::Vector3d n(std::cos(a * M_PI / 4), 0, std::sin(a * M_PI / 4));
-            AddScanPoint(prior_kf, o.step, cam_from_world,
+            AddScanPoint(world, o.step, cam_from_world,
                          Eigen::Vector3d(6.0 * side, y, s) + 0.2 * n, n, range(rng), &scan);
           }
     }
@@ -136,8 +144,9 @@ inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
       const Eigen::Vector3d road(8.0 * side, -3.0 + 4.5 * u(rng), s0 + 8.0 + 20.0 * u(rng));
       const int32_t id = static_cast<int32_t>(in.map_points.size());
       in.map_points.push_back(Perceived(prior_kf, o.step, road));
+      const Eigen::Vector3d measured = Perceived(world, o.step, road);
       for (int j = k; j < std::min(k + 3, o.keyframes); ++j) {
-        const Eigen::Vector3d p_j = prior_kf[j].Inverse() * in.map_points.back();
+        const Eigen::Vector3d p_j = world[j].Inverse() * measured;
         if (p_j.z() < 1.0 || !in.camera.InImage(in.camera.Project(p_j))) continue;
         const int octave = static_cast<int>(u(rng) * 4);
         const Eigen::Vector2d noise(pixel(rng), pixel(rng));
