@@ -1,0 +1,100 @@
+#include "io/odometry_io.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/check.h"
+#include "io/trajectory_io.h"
+
+namespace jvl::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+OdometryArtifact MakeArtifact(int n) {
+  OdometryArtifact a;
+  for (int i = 0; i < n; ++i) {
+    a.trajectory.Append(10 + i, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.01 * i, 0)),
+                                        Eigen::Vector3d(0.1, 0, 1.2 * i)),
+                        0.1 * i);
+    OdometryDiagnostics& d = a.diagnostics;
+    d.iterations.push_back(i);
+    d.residual.push_back(0.01 * i);
+    d.correspondences.push_back(900 - i);
+    d.time_ms.push_back(40.5 + i);
+    d.degenerate.push_back(i == 2);
+    d.points_after_filter.push_back(20000 + i);
+    d.status.push_back(i == 0 ? 1 : (i == 2 ? 2 : 0));
+    d.non_finite_points.push_back(i == 1 ? 7 : 0);
+    d.min_eigenvalue.push_back(0.05);
+  }
+  return a;
+}
+
+std::string TempPath(const std::string& name) {
+  return (fs::temp_directory_path() / (name + std::to_string(::getpid()) + ".h5")).string();
+}
+
+TEST(OdometryIoTest, RoundTripAndTrajectoryReader) {
+  const std::string path = TempPath("jvl_odom_rt_");
+  const OdometryArtifact a = MakeArtifact(4);
+  Provenance p;
+  p.tool = "test";
+  WriteOdometryArtifact(path, a, p);
+  const OdometryArtifact b = ReadOdometryArtifact(path);
+  EXPECT_EQ(b.trajectory.frames, a.trajectory.frames);
+  EXPECT_EQ(b.diagnostics.status, a.diagnostics.status);
+  EXPECT_EQ(b.diagnostics.degenerate, a.diagnostics.degenerate);
+  EXPECT_EQ(b.diagnostics.non_finite_points, a.diagnostics.non_finite_points);
+  EXPECT_DOUBLE_EQ(b.diagnostics.time_ms[3], 43.5);
+  // Any stage that expects a trajectory can read the odometry artifact.
+  const Trajectory t = ReadTrajectory(path);
+  ASSERT_EQ(t.size(), 4u);
+  EXPECT_NEAR(t.world_from_cam[3].translation().z(), 3.6, 1e-12);
+  fs::remove(path);
+}
+
+TEST(OdometryIoTest, MismatchedDiagnosticsRejected) {
+  OdometryArtifact a = MakeArtifact(3);
+  a.diagnostics.residual.pop_back();
+  try {
+    WriteOdometryArtifact(TempPath("jvl_odom_bad_"), a, Provenance());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(e.message().find("diagnostics/residual"), std::string::npos) << e.message();
+  }
+}
+
+// Every dataset the schema lists exists with the listed shape (symbolic N consistent).
+TEST(OdometryIoTest, WrittenLayoutMatchesSchema) {
+  const std::string path = TempPath("jvl_odom_schema_");
+  WriteOdometryArtifact(path, MakeArtifact(5), Provenance());
+  std::ifstream in(std::string(JVL_SOURCE_DIR) + "/schemas/odometry.schema.json");
+  ASSERT_TRUE(in.good());
+  const nlohmann::json schema = nlohmann::json::parse(in);
+  const H5Reader reader(path, "odometry", 1);
+  EXPECT_EQ(schema["x-hdf5"]["schema"], reader.schema());
+  EXPECT_EQ(schema["x-hdf5"]["schema_version"], reader.schema_version());
+  const nlohmann::json& datasets = schema["x-hdf5"]["datasets"];
+  ASSERT_GE(datasets.size(), 12u);
+  for (const auto& [name, spec] : datasets.items()) {
+    if (!reader.Has(name)) {
+      EXPECT_FALSE(spec.value("required", true)) << name << " missing";
+      continue;
+    }
+    const std::vector<int64_t> dims = reader.Dims(name);
+    ASSERT_EQ(dims.size(), spec["shape"].size()) << name;
+    for (size_t k = 0; k < dims.size(); ++k) {
+      const nlohmann::json& s = spec["shape"][k];
+      EXPECT_EQ(dims[k], s.is_string() ? 5 : s.get<int64_t>()) << name << " dim " << k;
+    }
+  }
+  fs::remove(path);
+}
+
+}  // namespace
+}  // namespace jvl::io

@@ -1,0 +1,108 @@
+#include "lidar/imls.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "lidar/surface.h"
+
+namespace jvl::lidar {
+namespace {
+
+TEST(ImlsTest, PlaneDistanceAndProjection) {
+  std::vector<Eigen::Vector3d> pts, normals;
+  for (double x = -2; x <= 2; x += 0.1) {
+    for (double y = -2; y <= 2; y += 0.1) {
+      pts.emplace_back(x, y, 1.0);
+      normals.emplace_back(0, 0, 1);
+    }
+  }
+  ImlsModel model(0.5);
+  model.AddScan(7, pts, normals);
+  for (const double off : {-0.3, -0.05, 0.0, 0.12, 0.4}) {
+    const Eigen::Vector3d x(0.33, -0.71, 1.0 + off);
+    ImlsProjection p;
+    ASSERT_TRUE(model.Project(x, 0.2, 0.5, &p)) << off;
+    EXPECT_NEAR(p.distance, off, 1e-9);
+    EXPECT_LT((p.projection - Eigen::Vector3d(0.33, -0.71, 1.0)).norm(), 1e-9);
+    EXPECT_EQ(p.nearest_scan, 7);
+  }
+  ImlsProjection p;
+  EXPECT_FALSE(model.Project(Eigen::Vector3d(0, 0, 1.6), 0.2, 0.5, &p));
+  EXPECT_TRUE(model.HasNeighbor(Eigen::Vector3d(0, 0, 1.4), 0.5));
+  EXPECT_FALSE(model.HasNeighbor(Eigen::Vector3d(0, 0, 1.6), 0.5));
+}
+
+TEST(ImlsTest, SphereDistance) {
+  // Points on a sphere of radius 5 (spacing ~0.05 m), outward normals.
+  const double radius = 5.0;
+  std::vector<Eigen::Vector3d> pts, normals;
+  for (double theta = 1.2; theta <= 1.9; theta += 0.01) {
+    for (double phi = -0.35; phi <= 0.35; phi += 0.01) {
+      const Eigen::Vector3d n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                              std::cos(theta));
+      pts.push_back(radius * n);
+      normals.push_back(n);
+    }
+  }
+  ImlsModel model(0.5);
+  model.AddScan(0, pts, normals);
+  const Eigen::Vector3d dir = Eigen::Vector3d(1, 0.1, -0.05).normalized();
+  for (const double off : {-0.2, -0.05, 0.1, 0.25}) {
+    ImlsProjection p;
+    ASSERT_TRUE(model.Project((radius + off) * dir, 0.1, 0.5, &p));
+    // Curvature bias of the kernel average is O(h^2 / R); the normal of the nearest sample
+    // is within half a grid step of dir.
+    EXPECT_NEAR(p.distance, off, 0.01) << off;
+    EXPECT_NEAR(p.projection.norm(), radius, 0.01) << off;
+  }
+}
+
+TEST(ImlsTest, ScansAddedAndRemoved) {
+  ImlsModel model(1.0);
+  model.AddScan(1, {{0, 0, 0}, {0.5, 0, 0}}, {{0, 0, 1}, {0, 0, 1}});
+  model.AddScan(2, {{0, 0, 0.2}}, {{0, 0, 1}});
+  EXPECT_EQ(model.size(), 3u);
+  EXPECT_EQ(model.scan_ids(), (std::vector<int64_t>{1, 2}));
+  model.RemoveScan(1);
+  EXPECT_EQ(model.size(), 1u);
+  ImlsProjection p;
+  ASSERT_TRUE(model.Project(Eigen::Vector3d(0, 0, 0.5), 0.1, 1.0, &p));
+  EXPECT_NEAR(p.distance, 0.3, 1e-12);
+  EXPECT_EQ(p.nearest_scan, 2);
+  model.RemoveScan(42);  // Absent: no-op.
+  model.RemoveScan(2);
+  EXPECT_EQ(model.size(), 0u);
+  EXPECT_FALSE(model.HasNeighbor(Eigen::Vector3d::Zero(), 1.0));
+}
+
+TEST(SurfaceTest, NormalsAndPlanarityOfAPlaneAndALine) {
+  std::vector<Eigen::Vector3d> pts;
+  for (double x = -3; x <= 3; x += 0.25) {
+    for (double z = 5; z <= 11; z += 0.25) pts.emplace_back(x, 1.5, z);  // Ground below.
+  }
+  const size_t n_plane = pts.size();
+  for (double z = 5; z <= 11; z += 0.2) pts.emplace_back(10, -3, z);  // An isolated line.
+  SurfaceOptions o;
+  const ScanSurface s = ComputeSurface(pts, o, 2);
+  for (size_t i = 0; i < n_plane; ++i) {
+    ASSERT_TRUE(s.valid[i]);
+    EXPECT_NEAR(s.normals[i].y(), -1.0, 1e-9);  // Towards the sensor (up is -y).
+    EXPECT_GT(s.planarity[i], 0.5);  // 1 inside the patch, lower at its border.
+  }
+  for (size_t i = n_plane; i < pts.size(); ++i) {
+    if (s.valid[i]) {
+      EXPECT_LT(s.planarity[i], 0.05);
+    }
+  }
+  // Sampling lists: translation along y is best constrained by the ground.
+  const auto lists = SamplingLists(s);
+  ASSERT_FALSE(lists[7].empty());
+  EXPECT_LT(static_cast<size_t>(lists[7].front()), n_plane);
+  const std::vector<int> picked = SelectSamples(lists, s.size(), 5, [](int) { return true; });
+  EXPECT_LE(picked.size(), 45u);
+  EXPECT_GE(picked.size(), 20u);
+}
+
+}  // namespace
+}  // namespace jvl::lidar

@@ -1,0 +1,51 @@
+// Scan-to-model registration on the IMLS surface (IMLS-SLAM Sec. V, paper Eq. 2): every
+// iteration projects the sampled scan points onto the implicit surface of the model and solves
+// a robust (Cauchy-weighted) linearised point-to-plane problem, until the update is below the
+// convergence thresholds or the iteration cap is reached.
+//
+// Degeneracy: the 6x6 normal matrix (rotation columns scaled by the mean sample range so both
+// blocks are unitless, divided by the total weight) is eigen-decomposed; directions whose
+// eigenvalue is below `degeneracy_threshold` are unobservable (a corridor along its axis). The
+// update is then restricted to the observable directions, so the pose keeps the initial guess
+// (the constant-velocity motion model) along the degenerate ones, and the result is flagged.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "geometry/rigid3.h"
+#include "lidar/imls.h"
+
+namespace jvl::lidar {
+
+struct RegistrationOptions {
+  int max_iterations = 20;                // IMLS-SLAM uses 20.
+  double kernel_h = 0.3;                  // m, h of W_i in Eq. (2).
+  double search_radius = 0.6;             // m, r: model neighbours of Eq. (2).
+  double max_distance = 0.5;              // m, |I(x)| above this: no correspondence.
+  double robust_scale = 0.1;              // m, Cauchy scale on I(x).
+  double convergence_translation = 1e-4;  // m per iteration.
+  double convergence_rotation = 1e-5;     // rad per iteration.
+  int min_correspondences = 30;           // fewer: no update, result.ok = false.
+  double degeneracy_threshold = 5e-3;     // On the normalised eigenvalues.
+  void Check() const;
+};
+
+struct RegistrationResult {
+  Rigid3d world_from_scan;
+  bool ok = false;         // Enough correspondences for an estimate.
+  bool converged = false;  // Stopped on the thresholds, not on the iteration cap.
+  int iterations = 0;
+  int correspondences = 0;       // At the last iteration.
+  double residual = 0;           // RMS of I(x) over the correspondences, m.
+  bool degenerate = false;       // Some direction fell back to the initial guess.
+  int degenerate_directions = 0;
+  double min_eigenvalue = 0;     // Smallest normalised eigenvalue (last iteration).
+};
+
+// points: sampled scan points in the scan frame. initial: predicted world_from_scan.
+RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
+                                const ImlsModel& model, const Rigid3d& initial,
+                                const RegistrationOptions& options, int threads);
+
+}  // namespace jvl::lidar

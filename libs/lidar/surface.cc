@@ -1,0 +1,121 @@
+#include "lidar/surface.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/check.h"
+#include "core/threads.h"
+#include "lidar/voxel_grid.h"
+
+namespace jvl::lidar {
+namespace {
+
+// Local PCA of point i's neighbourhood: normal = eigenvector of the smallest eigenvalue,
+// planarity a2D = (s2 - s3) / s1 (IMLS-SLAM Sec. V).
+void FitLocalPlane(const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<std::pair<double, int>>& nn, int i, ScanSurface* s) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& e : nn) mean += points[e.second];
+  mean /= static_cast<double>(nn.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& e : nn) {
+    const Eigen::Vector3d d = points[e.second] - mean;
+    cov += d * d.transpose();
+  }
+  cov /= static_cast<double>(nn.size());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  // Eigenvalues ascending: lambda3 <= lambda2 <= lambda1.
+  const Eigen::Vector3d l = eig.eigenvalues().cwiseMax(0.0);
+  const double s1 = std::sqrt(l[2]), s2 = std::sqrt(l[1]), s3 = std::sqrt(l[0]);
+  if (!(s1 > 0)) return;
+  Eigen::Vector3d n = eig.eigenvectors().col(0).normalized();
+  if (n.dot(points[i]) > 0) n = -n;  // Towards the sensor at the origin.
+  s->normals[i] = n;
+  s->planarity[i] = (s2 - s3) / s1;
+  s->valid[i] = 1;
+}
+
+}  // namespace
+
+void SurfaceOptions::Check() const {
+  JVL_CHECK(normal_neighbors >= 3, "--normal-neighbors must be >= 3, got " << normal_neighbors);
+  JVL_CHECK(normal_radius > 0, "--normal-radius must be > 0, got " << normal_radius);
+  JVL_CHECK(min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
+            "--min-normal-neighbors must be in [3, --normal-neighbors], got "
+                << min_normal_neighbors);
+}
+
+ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
+                           const SurfaceOptions& options, int threads) {
+  ScanSurface s;
+  s.points = points;
+  s.normals.assign(points.size(), Eigen::Vector3d::Zero());
+  s.planarity.assign(points.size(), 0.0);
+  s.valid.assign(points.size(), 0);
+  if (points.empty()) return s;
+  const PointGrid grid(points, options.normal_radius);
+  const double r2 = options.normal_radius * options.normal_radius;
+  const size_t k = static_cast<size_t>(options.normal_neighbors);
+  grid.ForEachCell(threads, [&](const std::vector<int>& members, const std::vector<int>& cand) {
+    // Candidate coordinates copied once per cell: the inner loop then streams through memory.
+    std::vector<Eigen::Vector3d> cp(cand.size());
+    for (size_t c = 0; c < cand.size(); ++c) cp[c] = points[cand[c]];
+    std::vector<std::pair<double, int>> nn;
+    for (const int i : members) {
+      nn.clear();
+      const Eigen::Vector3d& p = points[i];
+      for (size_t c = 0; c < cp.size(); ++c) {
+        const double d2 = (cp[c] - p).squaredNorm();
+        if (d2 <= r2) nn.emplace_back(d2, cand[c]);
+      }
+      if (nn.size() < static_cast<size_t>(options.min_normal_neighbors)) continue;
+      // The k nearest, (distance, index) pairs are unique so the set is deterministic.
+      if (nn.size() > k) {
+        std::nth_element(nn.begin(), nn.begin() + static_cast<std::ptrdiff_t>(k), nn.end());
+        nn.resize(k);
+      }
+      FitLocalPlane(points, nn, i, &s);
+    }
+  });
+  return s;
+}
+
+std::array<std::vector<int>, 9> SamplingLists(const ScanSurface& surface, size_t max_length) {
+  std::vector<int> valid;
+  for (size_t i = 0; i < surface.size(); ++i) {
+    if (surface.valid[i]) valid.push_back(static_cast<int>(i));
+  }
+  std::array<std::vector<int>, 9> lists;
+  std::vector<double> value(surface.size());
+  for (int k = 0; k < 9; ++k) {
+    for (const int i : valid) {
+      const Eigen::Vector3d& p = surface.points[i];
+      const Eigen::Vector3d& n = surface.normals[i];
+      const double a2 = surface.planarity[i] * surface.planarity[i];
+      if (k < 6) {
+        // Rotation about axis k/2 in the sign given by k%2.
+        const double sign = (k % 2 == 0) ? 1.0 : -1.0;
+        value[i] = a2 * sign * p.cross(n)[k / 2];
+      } else {
+        value[i] = a2 * std::abs(n[k - 6]);
+      }
+    }
+    lists[k] = valid;
+    const size_t keep = max_length == 0 ? valid.size() : std::min(max_length, valid.size());
+    if (keep == 0) continue;
+    const auto before = [&](int a, int b) {
+      return value[a] > value[b] || (value[a] == value[b] && a < b);
+    };
+    auto& list = lists[k];
+    std::nth_element(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(keep) - 1,
+                     list.end(), before);
+    list.resize(keep);
+    std::sort(list.begin(), list.end(), before);
+  }
+  return lists;
+}
+
+}  // namespace jvl::lidar
