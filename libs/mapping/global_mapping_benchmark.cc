@@ -17,12 +17,20 @@ void BM_Global4500Frames(benchmark::State& state) {
   so.keyframes = 1500;
   so.frames_per_keyframe = 3;
   so.yaw_drift = 0.01 * M_PI / 180.0;
+  so.biased_local = false;
   const auto syn = mapping::testing::MakeSyntheticGlobal(so);
+  size_t scan_points = 0;
+  for (const auto& s : syn.input.scans) scan_points += s.points.size();
+  state.counters["scan_points"] = static_cast<double>(scan_points);
   mapping::GlobalMappingOptions o;
   o.solve.threads = static_cast<int>(state.range(0));
   for (auto _ : state) {
     const auto r = mapping::OptimizeGlobal(syn.input, o);
-    state.counters["iterations"] = r.solve.iterations;
+    state.counters["iterations"] = r.total_iterations;
+    const auto ape = mapping::testing::Ape(syn.truth, r.keyframes);
+    const auto ape_prior = mapping::testing::Ape(syn.truth, syn.prior);
+    state.counters["ape_m"] = ape.translation_m;
+    state.counters["ape_prior_m"] = ape_prior.translation_m;
     state.counters["traversal_s"] = r.traversal_time_s;
     state.counters["solve_s"] = r.solve.time_s;
     state.counters["visual"] = static_cast<double>(r.solve.before.visual.count);

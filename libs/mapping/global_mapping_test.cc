@@ -251,3 +251,40 @@ TEST(GlobalMapping, AccumulatedMapIsVoxelDownsampled) {
 
 }  // namespace
 }  // namespace jvl::mapping
+
+namespace jvl::mapping {
+namespace {
+
+// Size check of a 4500-frame sequence (1500 keyframes, consistent world, 0.01 deg/keyframe
+// drift). Run with --gtest_also_run_disabled_tests; figures in docs/global_opt.md.
+TEST(GlobalMapping, DISABLED_Sequence4500Frames) {
+  SyntheticGlobalOptions so;
+  so.keyframes = 1500;
+  so.biased_local = false;
+  so.yaw_drift = 0.01 * M_PI / 180.0;
+  const Timer build;
+  const auto syn = MakeSyntheticGlobal(so);
+  const double build_s = build.ElapsedSeconds();
+  GlobalMappingOptions o;
+  o.solve.threads = 2;
+  const auto r = OptimizeGlobal(syn.input, o);
+  size_t points = 0;
+  for (const auto& s : syn.input.scans) points += s.points.size();
+  const auto ape_prior = Ape(syn.truth, syn.prior), ape = Ape(syn.truth, r.keyframes);
+  std::printf("4500 frames / %zu keyframes, %zu scan points: generate %.1f s; global %.1f s "
+              "(traversal %.1f s, %d rounds, %d LM iterations, last solve %.1f s); residuals "
+              "V %lld L %lld D %lld; peak RSS %.0f MiB; APE prior %.3f m -> %.3f m\n",
+              syn.input.keyframes.size(), points, build_s, r.total_time_s, r.traversal_time_s,
+              r.rounds, r.total_iterations, r.solve.time_s,
+              static_cast<long long>(r.solve.before.visual.count),
+              static_cast<long long>(r.solve.before.imls.count),
+              static_cast<long long>(r.solve.before.direction.count),
+              static_cast<double>(PeakMemoryBytes()) / (1 << 20), ape_prior.translation_m,
+              ape.translation_m);
+  EXPECT_TRUE(r.solve.usable);
+  EXPECT_LT(r.total_time_s, 120.0);
+  EXPECT_LT(PeakMemoryBytes(), int64_t{4} << 30);
+}
+
+}  // namespace
+}  // namespace jvl::mapping

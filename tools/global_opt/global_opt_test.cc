@@ -1,5 +1,5 @@
 // End-to-end: artifacts of a synthetic drifting sequence -> global_opt (library path and the
-// command line). The local artifact is written by a test fixture in the agreed layout.
+// command line).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -10,6 +10,7 @@
 #include "core/timer.h"
 #include "io/artifact.h"
 #include "io/files.h"
+#include "io/local_io.h"
 #include "io/global_io.h"
 #include "io/ply_io.h"
 #include "io/schema_check.h"
@@ -26,43 +27,40 @@ using mapping::testing::MakeSyntheticGlobal;
 using mapping::testing::SyntheticGlobal;
 using mapping::testing::SyntheticGlobalOptions;
 
-// "local" v1 as agreed between the stages (see libs/io/local_io.h once it exists).
-void WriteLocalFixture(const std::string& path, const SyntheticGlobal& syn,
-                       const std::vector<optim::ImlsCorrespondence>& l) {
-  io::H5Writer w(path, "local", 1);
-  io::WriteTrajectoryGroup(w, "keyframes", syn.input.keyframes);
-  std::vector<int32_t> n, c;
-  std::vector<double> px, py, nc, mp;
+// The local artifact local_map would write for this sequence (poses = the prior, L given).
+void WriteLocal(const std::string& path, const SyntheticGlobal& syn,
+                const std::vector<optim::ImlsCorrespondence>& l) {
+  io::LocalMapData d;
+  d.camera = syn.input.camera;
+  d.keyframes = syn.input.keyframes;
   for (const auto& x : l) {
-    n.push_back(static_cast<int32_t>(x.n));
-    c.push_back(static_cast<int32_t>(x.c));
-    px.insert(px.end(), x.p_x.data(), x.p_x.data() + 3);
-    py.insert(py.end(), x.c_p_y.data(), x.c_p_y.data() + 3);
-    nc.insert(nc.end(), x.c_normal.data(), x.c_normal.data() + 3);
+    d.imls_n.push_back(static_cast<int32_t>(x.n));
+    d.imls_c.push_back(static_cast<int32_t>(x.c));
+    d.imls_p_x.insert(d.imls_p_x.end(), x.p_x.data(), x.p_x.data() + 3);
+    d.imls_p_y.insert(d.imls_p_y.end(), x.c_p_y.data(), x.c_p_y.data() + 3);
+    d.imls_normal.insert(d.imls_normal.end(), x.c_normal.data(), x.c_normal.data() + 3);
   }
-  const int64_t nl = static_cast<int64_t>(n.size());
-  w.WriteArray("imls/n", n);
-  w.WriteArray("imls/c", c);
-  w.WriteArray("imls/p_x", px, {nl, 3});
-  w.WriteArray("imls/p_y", py, {nl, 3});
-  w.WriteArray("imls/normal", nc, {nl, 3});
-  for (const auto& p : syn.input.map_points) mp.insert(mp.end(), p.data(), p.data() + 3);
-  w.WriteArray("mappoints/position", mp, {static_cast<int64_t>(syn.input.map_points.size()), 3});
-  std::vector<int64_t> offset = {0};
-  std::vector<float> pts, nrm;
+  for (const auto& p : syn.input.map_points)
+    d.mappoint_position.insert(d.mappoint_position.end(), p.data(), p.data() + 3);
+  d.scan_offset = {0};
   for (const auto& s : syn.input.scans) {
     for (size_t i = 0; i < s.points.size(); ++i)
       for (int a = 0; a < 3; ++a) {
-        pts.push_back(static_cast<float>(s.points[i][a]));
-        nrm.push_back(static_cast<float>(s.normals[i][a]));
+        d.scan_points.push_back(static_cast<float>(s.points[i][a]));
+        d.scan_normals.push_back(static_cast<float>(s.normals[i][a]));
       }
-    offset.push_back(offset.back() + static_cast<int64_t>(s.points.size()));
+    d.scan_offset.push_back(d.scan_offset.back() + static_cast<int64_t>(s.points.size()));
   }
-  w.WriteArray("scans/offset", offset);
-  w.WriteArray("scans/points", pts, {offset.back(), 3});
-  w.WriteArray("scans/normals", nrm, {offset.back(), 3});
-  io::WriteTrajectoryGroup(w, "prior", syn.prior);
-  w.Commit(io::Provenance{});
+  for (const int64_t f : d.keyframes.frames) {
+    d.stats_frame.push_back(f);
+    d.stats_visual_residuals.push_back(0);
+    d.stats_imls_residuals.push_back(0);
+    d.stats_cost_before.push_back(0);
+    d.stats_cost_after.push_back(0);
+    d.stats_time_ms.push_back(0);
+  }
+  d.prior = syn.prior;
+  io::WriteLocalMap(path, d, io::Provenance{});
 }
 
 io::VisualMapData VisualOf(const SyntheticGlobal& syn) {
@@ -112,7 +110,7 @@ class GlobalOptTest : public ::testing::Test {
     local.scan_map_frames = 1;
     local.samples_per_list = 10;
     saved_ = mapping::TraverseImls(syn_.input.keyframes, syn_.input.scans, local, 1);
-    WriteLocalFixture(Path("local.h5"), syn_, saved_);
+    WriteLocal(Path("local.h5"), syn_, saved_);
     io::WriteVisualMap(Path("visual.h5"), VisualOf(syn_), io::Provenance{});
     io::WriteDirectionsArtifact(Path("directions.h5"), DirectionsOf(syn_), io::Provenance{});
   }

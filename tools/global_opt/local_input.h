@@ -1,7 +1,5 @@
-// Reader of the "local" artifact (schema "local" v1, written by local_map) limited to what
-// global_opt needs: refined keyframes, the saved correspondence set L, refined map points and the
-// stored per-keyframe scans. It reads the layout agreed between the stages through io::H5Reader;
-// the shared reader io/local_io.h replaces it once it exists.
+// What global_opt takes from the "local" artifact (io/local_io.h): refined keyframes, the saved
+// correspondence set L, refined map points and the stored per-keyframe scans, as plain values.
 #pragma once
 
 #include <Eigen/Core>
@@ -9,6 +7,7 @@
 #include <vector>
 
 #include "geometry/trajectory.h"
+#include "io/local_io.h"
 #include "mapping/global_mapping.h"
 #include "optim/joint_problem.h"
 
@@ -22,6 +21,7 @@ struct LocalInput {
   Trajectory prior;                                   // empty if absent
 };
 
+LocalInput ToLocalInput(const io::LocalMapData& data);
 LocalInput ReadLocalInput(const std::string& path);
 
 }  // namespace jvl::global_opt
