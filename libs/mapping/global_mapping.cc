@@ -48,6 +48,7 @@ void GlobalMappingOptions::Check() const {
   solve.Check();
   traversal.Check();
   JVL_CHECK(rounds >= 1, "rounds must be >= 1, got " << rounds);
+  JVL_CHECK(first_direction_round >= 0, "first_direction_round must be >= 0");
 }
 
 DirectionSelection SelectDirections(const Trajectory& keyframes,
@@ -84,27 +85,27 @@ size_t ModelStart(const Trajectory& keyframes, size_t n, int scan_map_frames) {
   return start;
 }
 
+void AddToModel(const Trajectory& keyframes, const std::vector<KeyframeScan>& scans, size_t i,
+                lidar::ImlsModel* model) {
+  const Rigid3d& world_from_i = keyframes.world_from_cam[i];
+  std::vector<Eigen::Vector3d> wp, wn;
+  for (size_t j = 0; j < scans[i].points.size(); ++j) {
+    if (scans[i].normals[j].squaredNorm() < 0.25) continue;
+    wp.push_back(world_from_i * scans[i].points[j]);
+    wn.push_back(world_from_i.rotation() * scans[i].normals[j]);
+  }
+  model->AddScan(static_cast<int64_t>(i), wp, wn);
+}
+
+// Steps 3-4 for keyframe n against `model` (the scans of its window, current poses).
 std::vector<optim::ImlsCorrespondence> TraverseKeyframe(const Trajectory& keyframes,
                                                         const std::vector<KeyframeScan>& scans,
-                                                        size_t n,
-                                                        const ImlsTraversalOptions& options) {
+                                                        size_t n, const lidar::ImlsModel& model,
+                                                        const ImlsTraversalOptions& options,
+                                                        int threads) {
   std::vector<optim::ImlsCorrespondence> out;
   const KeyframeScan& scan = scans[n];
-  if (n == 0 || scan.points.empty()) return out;
-  lidar::ImlsModel model(options.search_radius);
-  std::vector<Eigen::Vector3d> wp, wn;
-  for (size_t i = ModelStart(keyframes, n, options.scan_map_frames); i < n; ++i) {
-    const Rigid3d& world_from_i = keyframes.world_from_cam[i];
-    wp.clear();
-    wn.clear();
-    for (size_t j = 0; j < scans[i].points.size(); ++j) {
-      if (scans[i].normals[j].squaredNorm() < 0.25) continue;
-      wp.push_back(world_from_i * scans[i].points[j]);
-      wn.push_back(world_from_i.rotation() * scans[i].normals[j]);
-    }
-    model.AddScan(static_cast<int64_t>(i), wp, wn);
-  }
-  if (model.size() == 0) return out;
+  if (scan.points.empty() || model.size() == 0) return out;
   // IMLS-SLAM sampling on the stored normals (planarity taken as 1: the stored scan keeps
   // only points that had a normal).
   lidar::ScanSurface surface;
@@ -121,22 +122,27 @@ std::vector<optim::ImlsCorrespondence> TraverseKeyframe(const Trajectory& keyfra
       lidar::SelectSamples(lists, scan.points.size(), options.samples_per_list, [&](int j) {
         return model.HasNeighbor(world_from_n * scan.points[j], options.search_radius);
       });
-  for (const int j : samples) {
+  std::vector<uint8_t> ok(samples.size(), 0);
+  std::vector<optim::ImlsCorrespondence> found(samples.size());
+  ParallelFor(static_cast<int64_t>(samples.size()), threads, [&](int64_t s) {
+    const int j = samples[s];
     lidar::ImlsProjection proj;
     if (!model.Project(world_from_n * scan.points[j], options.kernel_h, options.search_radius,
                        &proj))
-      continue;
-    if (std::abs(proj.distance) > options.max_distance || proj.nearest_scan < 0) continue;
+      return;
+    if (std::abs(proj.distance) > options.max_distance || proj.nearest_scan < 0) return;
     const size_t c = static_cast<size_t>(proj.nearest_scan);
     const Rigid3d cam_from_world = keyframes.world_from_cam[c].Inverse();
-    optim::ImlsCorrespondence l;
+    optim::ImlsCorrespondence& l = found[s];
     l.n = static_cast<int64_t>(n);
     l.c = static_cast<int64_t>(c);
     l.p_x = scan.points[j];
     l.c_p_y = cam_from_world * proj.projection;  // ^c p_y = T_cw p_y (step 4)
     l.c_normal = (cam_from_world.rotation() * proj.normal).normalized();
-    out.push_back(l);
-  }
+    ok[s] = 1;
+  });
+  for (size_t s = 0; s < samples.size(); ++s)
+    if (ok[s]) out.push_back(found[s]);
   return out;
 }
 
@@ -149,13 +155,21 @@ std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
   options.Check();
   JVL_CHECK(scans.size() == keyframes.size(),
             "TraverseImls: " << scans.size() << " scans for " << keyframes.size() << " keyframes");
-  std::vector<std::vector<optim::ImlsCorrespondence>> per(keyframes.size());
-  ParallelFor(static_cast<int64_t>(keyframes.size()), ResolveThreadCount(threads),
-              [&](int64_t n) {
-                per[n] = TraverseKeyframe(keyframes, scans, static_cast<size_t>(n), options);
-              });
+  // The model of keyframe n holds the scans of keyframes ModelStart(n)..n-1 at the current
+  // poses; consecutive keyframes share most of it, so it slides (each scan is added once).
+  lidar::ImlsModel model(options.search_radius);
   std::vector<optim::ImlsCorrespondence> out;
-  for (auto& v : per) out.insert(out.end(), v.begin(), v.end());
+  const int workers = ResolveThreadCount(threads);
+  size_t next = 0;  // next scan to add
+  for (size_t n = 1; n < keyframes.size(); ++n) {
+    const size_t start = ModelStart(keyframes, n, options.scan_map_frames);
+    for (const int64_t id : model.scan_ids())
+      if (static_cast<size_t>(id) < start) model.RemoveScan(id);
+    for (next = std::max(next, start); next < n; ++next)
+      AddToModel(keyframes, scans, next, &model);
+    const auto l = TraverseKeyframe(keyframes, scans, n, model, options, workers);
+    out.insert(out.end(), l.begin(), l.end());
+  }
   return out;
 }
 
@@ -173,8 +187,7 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   const DirectionSelection dirs = SelectDirections(input.keyframes, input.directions);
   result.directions_not_keyframe = dirs.not_keyframe;
   result.directions_at_infinity = dirs.at_infinity;
-  if (options.use_directions) problem.directions = dirs.constraints;
-  result.directions_used = static_cast<int64_t>(problem.directions.size());
+  if (options.use_directions) result.directions_used = static_cast<int64_t>(dirs.constraints.size());
   result.keyframes = input.keyframes;
   const bool fresh = options.fresh_traversal && !input.scans.empty();
   const int rounds = fresh ? options.rounds : 1;
@@ -182,6 +195,9 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   for (int round = 0; round < rounds; ++round) {
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
+    problem.directions.clear();
+    if (options.use_directions && round >= std::min(options.first_direction_round, rounds - 1))
+      problem.directions = dirs.constraints;
     problem.imls.clear();
     if (options.use_saved_imls) problem.imls = input.saved_imls;
     result.saved_imls = static_cast<int64_t>(problem.imls.size());
@@ -194,10 +210,17 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
       result.fresh_imls = static_cast<int64_t>(l.size());
       result.traversal_time_s += t.ElapsedSeconds();
     }
+    if (round == 0 && options.use_directions && problem.directions.empty()) {
+      // Warm-start round without e_D: report the full energy at the input poses anyway.
+      optim::JointProblemInput full = problem;
+      full.directions = dirs.constraints;
+      auto built = optim::BuildJointProblem(full, options.joint);
+      first_before = optim::EvaluateJointCost(built, options.solve.threads);
+    }
     result.solve = optim::OptimizeJoint(problem, options.joint, options.solve);
     ++result.rounds;
     result.total_iterations += result.solve.iterations;
-    if (round == 0) first_before = result.solve.before;
+    if (round == 0 && first_before.total == 0.0) first_before = result.solve.before;
     if (!result.solve.usable) {
       spdlog::warn("global optimisation round {} failed ({}); keyframes keep the poses of the "
                    "previous round",

@@ -71,6 +71,8 @@ struct GlobalMappingOptions {
   // Rounds of (fresh traversal at the current poses, LM solve); round r > 0 starts from round
   // r - 1's poses and map points. 1 = the paper's single pass.
   int rounds = 2;
+  // Rounds before this one leave the direction residuals out (0 = directions in every round).
+  int first_direction_round = 1;
   void Check() const;
 };
 

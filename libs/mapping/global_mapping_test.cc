@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/check.h"
+#include "core/timer.h"
 #include "mapping/global_synthetic.h"
 #include "optim/correction.h"
 #include "optim/joint_problem.h"
@@ -140,6 +141,9 @@ AblationFigures RunAblation(const SyntheticGlobalOptions& so) {
   local.samples_per_list = 10;
   syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
   GlobalMappingOptions with = Quiet();
+  if (std::getenv("JVL_ROUNDS")) with.rounds = std::atoi(std::getenv("JVL_ROUNDS"));
+  if (std::getenv("JVL_ITER")) with.solve.max_iterations = std::atoi(std::getenv("JVL_ITER"));
+  if (std::getenv("JVL_FDR")) with.first_direction_round = std::atoi(std::getenv("JVL_FDR"));
   GlobalMappingOptions without = with;
   without.use_directions = false;
   AblationFigures f;
@@ -161,6 +165,7 @@ AblationFigures RunAblation(const SyntheticGlobalOptions& so) {
   f.prior = Ape(syn.truth, syn.prior);
   f.with = Ape(syn.truth, full_rate(f.result_with));
   f.without = Ape(syn.truth, full_rate(ro));
+  std::printf("iterations with %d (%d rounds, last %s), without %d\n", f.result_with.total_iterations, f.result_with.rounds, f.result_with.solve.termination.c_str(), ro.total_iterations);
   std::printf("%d keyframes, %.2f deg/keyframe, %s: APE prior %.3f m %.3f deg | without "
               "directions %.3f m %.3f deg | with %.3f m %.3f deg | beta %.3f gamma %.2f\n",
               so.keyframes, so.yaw_drift * 180 / M_PI,
@@ -189,8 +194,10 @@ TEST(GlobalMapping, DirectionPriorsRemoveAYawDriftTheOtherTermsCannot) {
 TEST(GlobalMapping, DirectionPriorsImproveOnAConsistentDriftingSequence) {
   SyntheticGlobalOptions so;
   so.keyframes = 60;
+  if (std::getenv("JVL_KF")) so.keyframes = std::atoi(std::getenv("JVL_KF"));
+  if (std::getenv("JVL_DRIFT")) so.yaw_drift = std::atof(std::getenv("JVL_DRIFT")) * M_PI / 180;
   so.biased_local = false;
-  so.yaw_drift = 0.1 * M_PI / 180.0;
+  if (!std::getenv("JVL_DRIFT")) so.yaw_drift = 0.1 * M_PI / 180.0;
   const auto f = RunAblation(so);
   EXPECT_LT(f.with.translation_m, 0.3 * f.prior.translation_m);
   EXPECT_LT(f.with.rotation_deg, 0.3 * f.prior.rotation_deg);
@@ -206,11 +213,12 @@ TEST(GlobalMapping, WeightsFollowTheRuleUnlessGiven) {
   o.solve.max_iterations = 1;
   const auto r = OptimizeGlobal(syn.input, o);
   const auto expected =
-      optim::ResolveWeights(o.joint, r.solve.before.visual.count, r.solve.before.imls.count,
-                            r.solve.before.direction.count);
+      optim::ResolveWeights(o.joint, r.solve.after.visual.count, r.solve.after.imls.count,
+                            r.solve.after.direction.count);
+  EXPECT_EQ(r.solve.before.direction.count, so.keyframes);  // full energy at the input poses
   EXPECT_DOUBLE_EQ(r.solve.weights.beta, expected.beta);
   EXPECT_DOUBLE_EQ(r.solve.weights.gamma, expected.gamma);
-  EXPECT_DOUBLE_EQ(r.solve.weights.gamma, static_cast<double>(r.solve.before.visual.count) /
+  EXPECT_DOUBLE_EQ(r.solve.weights.gamma, static_cast<double>(r.solve.after.visual.count) /
                                               static_cast<double>(so.keyframes));
   o.joint.beta = 2.5;
   o.joint.gamma = 7.0;
