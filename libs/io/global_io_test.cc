@@ -43,8 +43,8 @@ TEST_F(GlobalIoTest, RoundTripMatchesSchema) {
   Provenance p;
   p.tool = "global_opt";
   WriteGlobalArtifact(Path("g.h5"), Sample(), p);
-  const auto problems =
-      CheckH5AgainstSchema(Path("g.h5"), std::string(JVL_SOURCE_DIR) + "/schemas/global.schema.json");
+  const auto problems = CheckH5AgainstSchema(
+      Path("g.h5"), std::string(JVL_SOURCE_DIR) + "/schemas/global.schema.json");
   EXPECT_TRUE(problems.empty()) << problems.front();
   const GlobalData d = ReadGlobalArtifact(Path("g.h5"));
   ASSERT_EQ(d.keyframes.size(), 3u);

@@ -68,8 +68,7 @@ DirectionSelection SelectDirections(const Trajectory& keyframes,
     JVL_CHECK(a.direction_world.allFinite() && a.direction_world.norm() > 0.5,
               "direction prior of cluster " << a.cluster << " (frame " << a.frame
                                             << ") is not a unit vector");
-    out.constraints.push_back(
-        {static_cast<int64_t>(*row), a.uv, a.direction_world.normalized()});
+    out.constraints.push_back({static_cast<int64_t>(*row), a.uv, a.direction_world.normalized()});
   }
   return out;
 }
@@ -80,8 +79,7 @@ namespace {
 // but always at least n - 1 so that sparse keyframes still get a model.
 size_t ModelStart(const Trajectory& keyframes, size_t n, int scan_map_frames) {
   size_t start = n - 1;
-  while (start > 0 && keyframes.frames[n] - keyframes.frames[start - 1] <= scan_map_frames)
-    --start;
+  while (start > 0 && keyframes.frames[n] - keyframes.frames[start - 1] <= scan_map_frames) --start;
   return start;
 }
 
@@ -165,8 +163,7 @@ std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
     const size_t start = ModelStart(keyframes, n, options.scan_map_frames);
     for (const int64_t id : model.scan_ids())
       if (static_cast<size_t>(id) < start) model.RemoveScan(id);
-    for (next = std::max(next, start); next < n; ++next)
-      AddToModel(keyframes, scans, next, &model);
+    for (next = std::max(next, start); next < n; ++next) AddToModel(keyframes, scans, next, &model);
     const auto l = TraverseKeyframe(keyframes, scans, n, model, options, workers);
     out.insert(out.end(), l.begin(), l.end());
   }
@@ -187,7 +184,8 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   const DirectionSelection dirs = SelectDirections(input.keyframes, input.directions);
   result.directions_not_keyframe = dirs.not_keyframe;
   result.directions_at_infinity = dirs.at_infinity;
-  if (options.use_directions) result.directions_used = static_cast<int64_t>(dirs.constraints.size());
+  if (options.use_directions)
+    result.directions_used = static_cast<int64_t>(dirs.constraints.size());
   result.keyframes = input.keyframes;
   const bool fresh = options.fresh_traversal && !input.scans.empty();
   const int rounds = fresh ? options.rounds : 1;
@@ -222,9 +220,10 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
     result.total_iterations += result.solve.iterations;
     if (round == 0 && first_before.total == 0.0) first_before = result.solve.before;
     if (!result.solve.usable) {
-      spdlog::warn("global optimisation round {} failed ({}); keyframes keep the poses of the "
-                   "previous round",
-                   round, result.solve.termination);
+      spdlog::warn(
+          "global optimisation round {} failed ({}); keyframes keep the poses of the "
+          "previous round",
+          round, result.solve.termination);
       break;
     }
     for (size_t i = 0; i < result.keyframes.size(); ++i)
@@ -255,19 +254,25 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
   const auto& s = r.solve;
   return {{"before", BreakdownOf(s.before)},
           {"after", BreakdownOf(s.after)},
-          {"weights", {{"alpha", s.weights.alpha}, {"beta", s.weights.beta},
-                       {"gamma", s.weights.gamma}}},
+          {"weights",
+           {{"alpha", s.weights.alpha}, {"beta", s.weights.beta}, {"gamma", s.weights.gamma}}},
           {"weights_from_rule", {{"beta", o.joint.beta <= 0}, {"gamma", o.joint.gamma <= 0}}},
           {"imls", {{"saved", r.saved_imls}, {"fresh", r.fresh_imls}}},
-          {"directions", {{"used", r.directions_used},
-                          {"not_keyframe", r.directions_not_keyframe},
-                          {"at_infinity", r.directions_at_infinity},
-                          {"enabled", o.use_directions}}},
-          {"solver", {{"usable", s.usable}, {"iterations", r.total_iterations},
-                      {"rounds", r.rounds}, {"last_round_iterations", s.iterations},
-                      {"time_s", s.time_s}, {"termination", s.termination},
-                      {"linear_solver", s.linear_solver}, {"threads", o.solve.threads},
-                      {"max_iterations", o.solve.max_iterations}}},
+          {"directions",
+           {{"used", r.directions_used},
+            {"not_keyframe", r.directions_not_keyframe},
+            {"at_infinity", r.directions_at_infinity},
+            {"enabled", o.use_directions}}},
+          {"solver",
+           {{"usable", s.usable},
+            {"iterations", r.total_iterations},
+            {"rounds", r.rounds},
+            {"last_round_iterations", s.iterations},
+            {"time_s", s.time_s},
+            {"termination", s.termination},
+            {"linear_solver", s.linear_solver},
+            {"threads", o.solve.threads},
+            {"max_iterations", o.solve.max_iterations}}},
           {"traversal_time_s", r.traversal_time_s},
           {"total_time_s", r.total_time_s}};
 }
@@ -276,8 +281,7 @@ std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,
                                            const std::vector<KeyframeScan>& scans,
                                            double voxel_size) {
   JVL_CHECK(scans.size() == keyframes.size(),
-            "AccumulateMap: " << scans.size() << " scans for " << keyframes.size()
-                              << " keyframes");
+            "AccumulateMap: " << scans.size() << " scans for " << keyframes.size() << " keyframes");
   std::vector<Eigen::Vector3f> out;
   std::unordered_set<uint64_t, lidar::CellHash> occupied;
   const double inv = voxel_size > 0 ? 1.0 / voxel_size : 0.0;

@@ -43,21 +43,21 @@ struct DirectionAssociation {
 struct GlobalMapInput {
   PinholeCamera camera;
   Trajectory keyframes;  // Frames + current (local-mapping refined) world_from_cam0.
-  std::vector<Eigen::Vector3d> map_points;                // World.
-  std::vector<optim::VisualObservation> observations;     // keyframe = row.
-  std::vector<optim::ImlsCorrespondence> saved_imls;      // The set L; n, c = rows.
-  std::vector<KeyframeScan> scans;                        // One per keyframe row (may be empty).
-  std::vector<DirectionAssociation> directions;           // Any frames; non-keyframes skipped.
+  std::vector<Eigen::Vector3d> map_points;             // World.
+  std::vector<optim::VisualObservation> observations;  // keyframe = row.
+  std::vector<optim::ImlsCorrespondence> saved_imls;   // The set L; n, c = rows.
+  std::vector<KeyframeScan> scans;                     // One per keyframe row (may be empty).
+  std::vector<DirectionAssociation> directions;        // Any frames; non-keyframes skipped.
   void Check() const;
 };
 
 // Fresh point-to-IMLS traversal (local mapping steps 2-4 for every keyframe).
 struct ImlsTraversalOptions {
-  int scan_map_frames = 10;   // N: model = keyframes i < n with f_n - f_i <= N (at least n-1).
-  int samples_per_list = 30;  // IMLS-SLAM sampling: points taken from each of the 9 lists.
-  double kernel_h = 0.3;      // m, h of W_i in Eq. (2).
+  int scan_map_frames = 10;    // N: model = keyframes i < n with f_n - f_i <= N (at least n-1).
+  int samples_per_list = 30;   // IMLS-SLAM sampling: points taken from each of the 9 lists.
+  double kernel_h = 0.3;       // m, h of W_i in Eq. (2).
   double search_radius = 0.6;  // m, model neighbours of Eq. (2).
-  double max_distance = 0.5;  // m, |I(x)| above this: no correspondence.
+  double max_distance = 0.5;   // m, |I(x)| above this: no correspondence.
   void Check() const;
 };
 
@@ -65,9 +65,9 @@ struct GlobalMappingOptions {
   optim::JointProblemOptions joint;  // alpha/beta/gamma (<= 0: ResolveWeights rule), sigmas.
   optim::SolveOptions solve;         // LM iterations, threads.
   ImlsTraversalOptions traversal;
-  bool use_directions = true;    // false: the --no-direction ablation.
-  bool use_saved_imls = true;    // the set L of local mapping
-  bool fresh_traversal = true;   // the fresh Eq. (3) traversal of all keyframes
+  bool use_directions = true;   // false: the --no-direction ablation.
+  bool use_saved_imls = true;   // the set L of local mapping
+  bool fresh_traversal = true;  // the fresh Eq. (3) traversal of all keyframes
   // Rounds of (fresh traversal at the current poses, LM solve); round r > 0 starts from round
   // r - 1's poses and map points. 1 = the paper's single pass.
   int rounds = 2;

@@ -141,9 +141,6 @@ AblationFigures RunAblation(const SyntheticGlobalOptions& so) {
   local.samples_per_list = 10;
   syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
   GlobalMappingOptions with = Quiet();
-  if (std::getenv("JVL_ROUNDS")) with.rounds = std::atoi(std::getenv("JVL_ROUNDS"));
-  if (std::getenv("JVL_ITER")) with.solve.max_iterations = std::atoi(std::getenv("JVL_ITER"));
-  if (std::getenv("JVL_FDR")) with.first_direction_round = std::atoi(std::getenv("JVL_FDR"));
   GlobalMappingOptions without = with;
   without.use_directions = false;
   AblationFigures f;
@@ -165,14 +162,13 @@ AblationFigures RunAblation(const SyntheticGlobalOptions& so) {
   f.prior = Ape(syn.truth, syn.prior);
   f.with = Ape(syn.truth, full_rate(f.result_with));
   f.without = Ape(syn.truth, full_rate(ro));
-  std::printf("iterations with %d (%d rounds, last %s), without %d\n", f.result_with.total_iterations, f.result_with.rounds, f.result_with.solve.termination.c_str(), ro.total_iterations);
-  std::printf("%d keyframes, %.2f deg/keyframe, %s: APE prior %.3f m %.3f deg | without "
-              "directions %.3f m %.3f deg | with %.3f m %.3f deg | beta %.3f gamma %.2f\n",
-              so.keyframes, so.yaw_drift * 180 / M_PI,
-              so.biased_local ? "biased local terms" : "consistent world", f.prior.translation_m,
-              f.prior.rotation_deg, f.without.translation_m, f.without.rotation_deg,
-              f.with.translation_m, f.with.rotation_deg, f.result_with.solve.weights.beta,
-              f.result_with.solve.weights.gamma);
+  std::printf(
+      "%d keyframes, %.2f deg/keyframe, %s: APE prior %.3f m %.3f deg | without "
+      "directions %.3f m %.3f deg | with %.3f m %.3f deg | beta %.3f gamma %.2f\n",
+      so.keyframes, so.yaw_drift * 180 / M_PI,
+      so.biased_local ? "biased local terms" : "consistent world", f.prior.translation_m,
+      f.prior.rotation_deg, f.without.translation_m, f.without.rotation_deg, f.with.translation_m,
+      f.with.rotation_deg, f.result_with.solve.weights.beta, f.result_with.solve.weights.gamma);
   return f;
 }
 
@@ -194,10 +190,8 @@ TEST(GlobalMapping, DirectionPriorsRemoveAYawDriftTheOtherTermsCannot) {
 TEST(GlobalMapping, DirectionPriorsImproveOnAConsistentDriftingSequence) {
   SyntheticGlobalOptions so;
   so.keyframes = 60;
-  if (std::getenv("JVL_KF")) so.keyframes = std::atoi(std::getenv("JVL_KF"));
-  if (std::getenv("JVL_DRIFT")) so.yaw_drift = std::atof(std::getenv("JVL_DRIFT")) * M_PI / 180;
   so.biased_local = false;
-  if (!std::getenv("JVL_DRIFT")) so.yaw_drift = 0.1 * M_PI / 180.0;
+  so.yaw_drift = 0.1 * M_PI / 180.0;
   const auto f = RunAblation(so);
   EXPECT_LT(f.with.translation_m, 0.3 * f.prior.translation_m);
   EXPECT_LT(f.with.rotation_deg, 0.3 * f.prior.rotation_deg);
@@ -212,9 +206,8 @@ TEST(GlobalMapping, WeightsFollowTheRuleUnlessGiven) {
   GlobalMappingOptions o = Quiet();
   o.solve.max_iterations = 1;
   const auto r = OptimizeGlobal(syn.input, o);
-  const auto expected =
-      optim::ResolveWeights(o.joint, r.solve.after.visual.count, r.solve.after.imls.count,
-                            r.solve.after.direction.count);
+  const auto expected = optim::ResolveWeights(
+      o.joint, r.solve.after.visual.count, r.solve.after.imls.count, r.solve.after.direction.count);
   EXPECT_EQ(r.solve.before.direction.count, so.keyframes);  // full energy at the input poses
   EXPECT_DOUBLE_EQ(r.solve.weights.beta, expected.beta);
   EXPECT_DOUBLE_EQ(r.solve.weights.gamma, expected.gamma);
@@ -279,16 +272,16 @@ TEST(GlobalMapping, DISABLED_Sequence4500Frames) {
   size_t points = 0;
   for (const auto& s : syn.input.scans) points += s.points.size();
   const auto ape_prior = Ape(syn.truth, syn.prior), ape = Ape(syn.truth, r.keyframes);
-  std::printf("4500 frames / %zu keyframes, %zu scan points: generate %.1f s; global %.1f s "
-              "(traversal %.1f s, %d rounds, %d LM iterations, last solve %.1f s); residuals "
-              "V %lld L %lld D %lld; peak RSS %.0f MiB; APE prior %.3f m -> %.3f m\n",
-              syn.input.keyframes.size(), points, build_s, r.total_time_s, r.traversal_time_s,
-              r.rounds, r.total_iterations, r.solve.time_s,
-              static_cast<long long>(r.solve.before.visual.count),
-              static_cast<long long>(r.solve.before.imls.count),
-              static_cast<long long>(r.solve.before.direction.count),
-              static_cast<double>(PeakMemoryBytes()) / (1 << 20), ape_prior.translation_m,
-              ape.translation_m);
+  std::printf(
+      "4500 frames / %zu keyframes, %zu scan points: generate %.1f s; global %.1f s "
+      "(traversal %.1f s, %d rounds, %d LM iterations, last solve %.1f s); residuals "
+      "V %lld L %lld D %lld; peak RSS %.0f MiB; APE prior %.3f m -> %.3f m\n",
+      syn.input.keyframes.size(), points, build_s, r.total_time_s, r.traversal_time_s, r.rounds,
+      r.total_iterations, r.solve.time_s, static_cast<long long>(r.solve.before.visual.count),
+      static_cast<long long>(r.solve.before.imls.count),
+      static_cast<long long>(r.solve.before.direction.count),
+      static_cast<double>(PeakMemoryBytes()) / (1 << 20), ape_prior.translation_m,
+      ape.translation_m);
   EXPECT_TRUE(r.solve.usable);
   EXPECT_LT(r.total_time_s, 120.0);
   EXPECT_LT(PeakMemoryBytes(), int64_t{4} << 30);

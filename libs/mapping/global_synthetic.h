@@ -25,10 +25,10 @@ namespace jvl::mapping::testing {
 struct SyntheticGlobalOptions {
   int keyframes = 40;
   int frames_per_keyframe = 3;
-  double step = 2.0;                        // m between keyframes
-  double yaw_drift = 0.25 * M_PI / 180.0;   // rad per keyframe
-  double scan_range = 25.0;                 // m along the road, both sides
-  double scan_spacing = 1.0;                // m grid of the sampled surfaces
+  double step = 2.0;                       // m between keyframes
+  double yaw_drift = 0.25 * M_PI / 180.0;  // rad per keyframe
+  double scan_range = 25.0;                // m along the road, both sides
+  double scan_spacing = 1.0;               // m grid of the sampled surfaces
   int map_points_per_keyframe = 30;
   uint32_t seed = 7;
   // true: the biased-odometry model above (local terms consistent with the prior). false: a
@@ -40,9 +40,9 @@ struct SyntheticGlobalOptions {
 };
 
 struct SyntheticGlobal {
-  GlobalMapInput input;     // keyframes = the drifted prior at the keyframes
-  Trajectory truth;         // full rate
-  Trajectory prior;         // full rate
+  GlobalMapInput input;  // keyframes = the drifted prior at the keyframes
+  Trajectory truth;      // full rate
+  Trajectory prior;      // full rate
   std::vector<Rigid3d> truth_keyframes;
 };
 
@@ -74,9 +74,9 @@ inline Eigen::Vector3d Perceived(const std::vector<Rigid3d>& prior_kf, double st
   return PriorAt(prior_kf, step, road.z()) * Eigen::Vector3d(road.x(), road.y(), 0.0);
 }
 
-inline void AddScanPoint(const std::vector<Rigid3d>& prior_kf, double step, const Rigid3d& cam_from_world,
-                         const Eigen::Vector3d& road, const Eigen::Vector3d& road_normal,
-                         double noise, KeyframeScan* scan) {
+inline void AddScanPoint(const std::vector<Rigid3d>& prior_kf, double step,
+                         const Rigid3d& cam_from_world, const Eigen::Vector3d& road,
+                         const Eigen::Vector3d& road_normal, double noise, KeyframeScan* scan) {
   const Rigid3d frame = PriorAt(prior_kf, step, road.z());
   const Eigen::Vector3d n_w = frame.rotation() * road_normal;
   const Eigen::Vector3d p_w = Perceived(prior_kf, step, road) + noise * n_w;
@@ -124,7 +124,8 @@ inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
                      -Eigen::Vector3d::UnitY(), range(rng), &scan);
       for (double y = -3.0; y <= 1.5; y += sp)  // walls
         for (double side : {-1.0, 1.0})
-          AddScanPoint(world, o.step, cam_from_world, {8.0 * side, y + 0.3 * u(rng), s + 0.3 * u(rng)},
+          AddScanPoint(world, o.step, cam_from_world,
+                       {8.0 * side, y + 0.3 * u(rng), s + 0.3 * u(rng)},
                        Eigen::Vector3d(-side, 0, 0), range(rng), &scan);
     }
     for (double s = 15.0 * std::floor((s0 - o.scan_range) / 15.0); s <= s0 + o.scan_range;
@@ -133,8 +134,8 @@ inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
         for (double y = -2.0; y <= 1.5; y += 0.5)
           for (int a = 0; a < 8; ++a) {
             const Eigen::Vector3d n(std::cos(a * M_PI / 4), 0, std::sin(a * M_PI / 4));
-            AddScanPoint(world, o.step, cam_from_world,
-                         Eigen::Vector3d(6.0 * side, y, s) + 0.2 * n, n, range(rng), &scan);
+            AddScanPoint(world, o.step, cam_from_world, Eigen::Vector3d(6.0 * side, y, s) + 0.2 * n,
+                         n, range(rng), &scan);
           }
     }
     in.scans.push_back(std::move(scan));
@@ -158,8 +159,8 @@ inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
     const Eigen::Vector3d d_w = Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d d_c = out.truth_keyframes[k].rotation().conjugate() * d_w;
     in.directions.push_back({in.keyframes.frames[k],
-                             in.camera.Project(d_c) + Eigen::Vector2d(pixel(rng), pixel(rng)),
-                             d_w, 0});
+                             in.camera.Project(d_c) + Eigen::Vector2d(pixel(rng), pixel(rng)), d_w,
+                             0});
   }
   return out;
 }

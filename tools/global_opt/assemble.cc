@@ -10,17 +10,15 @@ mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual,
                                             const LocalInput& local,
                                             const io::DirectionsData* directions) {
   JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
-            "local and visual artifacts have different keyframes (" << local.keyframes.size()
-                                                                    << " vs "
-                                                                    << visual.keyframes.size()
-                                                                    << ")");
+            "local and visual artifacts have different keyframes ("
+                << local.keyframes.size() << " vs " << visual.keyframes.size() << ")");
   mapping::GlobalMapInput in;
   in.camera = visual.camera;
   in.keyframes = local.keyframes;
   const size_t m = visual.num_mappoints();
   if (!local.mappoints.empty()) {
-    JVL_CHECK(local.mappoints.size() == m, "local has " << local.mappoints.size()
-                                                        << " map points, visual " << m);
+    JVL_CHECK(local.mappoints.size() == m,
+              "local has " << local.mappoints.size() << " map points, visual " << m);
     in.map_points = local.mappoints;
   } else {
     for (size_t i = 0; i < m; ++i)
@@ -45,8 +43,8 @@ mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual,
     for (const auto& c : directions->clusters) d_w[c.id] = c.direction;
     for (const auto& a : directions->associations) {
       const auto it = d_w.find(a.cluster);
-      JVL_CHECK(it != d_w.end(), "association of frame " << a.frame << " names unknown cluster "
-                                                         << a.cluster);
+      JVL_CHECK(it != d_w.end(),
+                "association of frame " << a.frame << " names unknown cluster " << a.cluster);
       in.directions.push_back({a.frame, a.uv, it->second, a.cluster});
     }
   }

@@ -10,8 +10,8 @@
 #include "core/timer.h"
 #include "io/artifact.h"
 #include "io/files.h"
-#include "io/local_io.h"
 #include "io/global_io.h"
+#include "io/local_io.h"
 #include "io/ply_io.h"
 #include "io/schema_check.h"
 #include "io/trajectory_io.h"
@@ -141,18 +141,17 @@ TEST_F(GlobalOptTest, ArtifactsAssembleToTheSameInput) {
 TEST_F(GlobalOptTest, CommandLineWithAndWithoutDirections) {
   const std::string exe = std::string(JVL_BINARY_DIR) + "/bin/global_opt";
   if (!io::FileExists(exe)) GTEST_SKIP() << exe << " not built";
-  const std::string base = exe + " --local " + Path("local.h5") + " --visual " +
-                           Path("visual.h5") + " --threads 2 --quiet --log-level warn";
+  const std::string base = exe + " --local " + Path("local.h5") + " --visual " + Path("visual.h5") +
+                           " --threads 2 --quiet --log-level warn";
   const Timer t;
-  const std::string with = base + " --directions " + Path("directions.h5") + " -o " +
-                           Path("g.h5") + " --kitti-poses " + Path("g.txt") + " --map " +
-                           Path("map.ply");
+  const std::string with = base + " --directions " + Path("directions.h5") + " -o " + Path("g.h5") +
+                           " --kitti-poses " + Path("g.txt") + " --map " + Path("map.ply");
   ASSERT_EQ(std::system(with.c_str()), 0) << with;
   const double seconds = t.ElapsedSeconds();
   const std::string without = base + " --no-direction -o " + Path("n.h5");
   ASSERT_EQ(std::system(without.c_str()), 0) << without;
-  const std::string gamma = base + " --directions " + Path("directions.h5") + " --gamma 5 -o " +
-                            Path("g5.h5");
+  const std::string gamma =
+      base + " --directions " + Path("directions.h5") + " --gamma 5 -o " + Path("g5.h5");
   ASSERT_EQ(std::system(gamma.c_str()), 0) << gamma;
   EXPECT_TRUE(io::CheckH5AgainstSchema(Path("g.h5"),
                                        std::string(JVL_SOURCE_DIR) + "/schemas/global.schema.json")
@@ -169,10 +168,11 @@ TEST_F(GlobalOptTest, CommandLineWithAndWithoutDirections) {
   EXPECT_DOUBLE_EQ(g5.stats["weights"]["gamma"].get<double>(), 5.0);
   const auto ap = Ape(syn_.truth, syn_.prior), ag = Ape(syn_.truth, g.trajectory),
              an = Ape(syn_.truth, n.trajectory);
-  std::printf("tool, 40 keyframes / 118 frames: APE prior %.3f m %.3f deg, without %.3f m %.3f "
-              "deg, with %.3f m %.3f deg; run with directions %.2f s\n",
-              ap.translation_m, ap.rotation_deg, an.translation_m, an.rotation_deg,
-              ag.translation_m, ag.rotation_deg, seconds);
+  std::printf(
+      "tool, 40 keyframes / 118 frames: APE prior %.3f m %.3f deg, without %.3f m %.3f "
+      "deg, with %.3f m %.3f deg; run with directions %.2f s\n",
+      ap.translation_m, ap.rotation_deg, an.translation_m, an.rotation_deg, ag.translation_m,
+      ag.rotation_deg, seconds);
   EXPECT_LT(ag.rotation_deg, 0.3 * ap.rotation_deg);
   EXPECT_LT(ag.translation_m, 0.85 * an.translation_m);
   // Bad input: one clear error line, non-zero exit.

@@ -21,7 +21,8 @@ LocalInput ToLocalInput(const io::LocalMapData& d) {
   for (size_t i = 0; i < d.num_correspondences(); ++i)
     out.imls.push_back({d.imls_n[i], d.imls_c[i], Row3(d.imls_p_x, i), Row3(d.imls_p_y, i),
                         Row3(d.imls_normal, i).normalized()});
-  for (size_t i = 0; i < d.num_mappoints(); ++i) out.mappoints.push_back(Row3(d.mappoint_position, i));
+  for (size_t i = 0; i < d.num_mappoints(); ++i)
+    out.mappoints.push_back(Row3(d.mappoint_position, i));
   if (!d.scan_offset.empty()) {
     out.scans.resize(k);
     for (size_t i = 0; i < k; ++i)
@@ -34,8 +35,6 @@ LocalInput ToLocalInput(const io::LocalMapData& d) {
   return out;
 }
 
-LocalInput ReadLocalInput(const std::string& path) {
-  return ToLocalInput(io::ReadLocalMap(path));
-}
+LocalInput ReadLocalInput(const std::string& path) { return ToLocalInput(io::ReadLocalMap(path)); }
 
 }  // namespace jvl::global_opt

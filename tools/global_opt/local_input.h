@@ -14,11 +14,11 @@
 namespace jvl::global_opt {
 
 struct LocalInput {
-  Trajectory keyframes;                               // refined
-  std::vector<optim::ImlsCorrespondence> imls;        // n, c = keyframe rows
-  std::vector<Eigen::Vector3d> mappoints;             // refined, visual.h5 rows
-  std::vector<mapping::KeyframeScan> scans;           // one per keyframe
-  Trajectory prior;                                   // empty if absent
+  Trajectory keyframes;                         // refined
+  std::vector<optim::ImlsCorrespondence> imls;  // n, c = keyframe rows
+  std::vector<Eigen::Vector3d> mappoints;       // refined, visual.h5 rows
+  std::vector<mapping::KeyframeScan> scans;     // one per keyframe
+  Trajectory prior;                             // empty if absent
 };
 
 LocalInput ToLocalInput(const io::LocalMapData& data);

@@ -43,7 +43,14 @@ int main(int argc, char** argv) {
   cli.add_option("--samples-per-list", o.traversal.samples_per_list,
                  "IMLS-SLAM samples per list (9 lists) in the fresh traversal")
       ->capture_default_str();
-  cli.add_option("--max-iterations", o.solve.max_iterations, "Levenberg-Marquardt iterations")
+  cli.add_option("--max-iterations", o.solve.max_iterations,
+                 "Levenberg-Marquardt iterations per round")
+      ->capture_default_str();
+  cli.add_option("--rounds", o.rounds,
+                 "Rounds of (fresh IMLS traversal at the current poses, LM solve)")
+      ->capture_default_str();
+  cli.add_option("--first-direction-round", o.first_direction_round,
+                 "Rounds before this one run without e_D (warm start; 0 = e_D in every round)")
       ->capture_default_str();
   cli.add_option("--map", map_path, "Accumulated map PLY (stored scans, optimised poses)");
   cli.add_option("--map-voxel", map_voxel, "Voxel size (m) of the map")->capture_default_str();
@@ -92,11 +99,12 @@ int main(int argc, char** argv) {
     spdlog::info(
         "{} keyframes, {} frames: {} visual, {} IMLS ({} saved + {} fresh), {} direction "
         "residuals ({} skipped: not keyframes, {} at infinity); weights alpha {:.3g} beta {:.3g} "
-        "gamma {:.3g}; cost {:.6g} -> {:.6g} in {} iterations ({:.2f} s solve, {:.2f} s total)",
-        result.keyframes.size(), out.trajectory.size(), s.before.visual.count,
-        s.before.imls.count, result.saved_imls, result.fresh_imls, s.before.direction.count,
+        "gamma {:.3g}; cost {:.6g} -> {:.6g}; {} rounds, {} iterations ({:.2f} s IMLS "
+        "traversal, {:.2f} s total)",
+        result.keyframes.size(), out.trajectory.size(), s.before.visual.count, s.before.imls.count,
+        result.saved_imls, result.fresh_imls, s.before.direction.count,
         result.directions_not_keyframe, result.directions_at_infinity, s.weights.alpha,
-        s.weights.beta, s.weights.gamma, s.before.total, s.after.total, s.iterations, s.time_s,
-        result.total_time_s);
+        s.weights.beta, s.weights.gamma, s.before.total, s.after.total, result.rounds,
+        result.total_iterations, result.traversal_time_s, result.total_time_s);
   });
 }
