@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
   cli.add_option("--first-direction-round", o.first_direction_round,
                  "Rounds before this one run without e_D (warm start; 0 = e_D in every round)")
       ->capture_default_str();
+  cli.add_flag("!--fixed-map-points", o.joint.optimize_map_points,
+               "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only)");
   cli.add_option("--map", map_path, "Accumulated map PLY (stored scans, optimised poses)");
   cli.add_option("--map-voxel", map_voxel, "Voxel size (m) of the map")->capture_default_str();
   cli.add_flag("--map-ascii", map_ascii, "Write the PLY as ASCII instead of binary");
