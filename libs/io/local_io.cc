@@ -1,0 +1,106 @@
+#include "io/local_io.h"
+
+#include "core/check.h"
+#include "io/trajectory_io.h"
+
+namespace jvl::io {
+namespace {
+
+template <typename T>
+void CheckSize(const std::vector<T>& v, size_t n, const char* name, const std::string& what) {
+  JVL_CHECK(v.size() == n,
+            what << ": " << name << " has " << v.size() << " values, expected " << n);
+}
+
+}  // namespace
+
+void LocalMapData::Check(const std::string& what) const {
+  keyframes.Check((what + " keyframes").c_str());
+  const size_t k = keyframes.size(), l = num_correspondences(), s = num_scan_points();
+  CheckSize(imls_c, l, "imls/c", what);
+  CheckSize(imls_p_x, 3 * l, "imls/p_x", what);
+  CheckSize(imls_p_y, 3 * l, "imls/p_y", what);
+  CheckSize(imls_normal, 3 * l, "imls/normal", what);
+  JVL_CHECK(mappoint_position.size() % 3 == 0, what << ": mappoints/position is not M x 3");
+  CheckSize(scan_offset, k + 1, "scans/offset", what);
+  CheckSize(scan_normals, 3 * s, "scans/normals", what);
+  JVL_CHECK(scan_points.size() == 3 * s, what << ": scans/points is not S x 3");
+  for (size_t i = 0; i < k; ++i) {
+    JVL_CHECK(scan_offset[i] <= scan_offset[i + 1],
+              what << ": scans/offset decreases at keyframe row " << i);
+  }
+  JVL_CHECK(scan_offset.front() == 0 && scan_offset.back() == static_cast<int64_t>(s),
+            what << ": scans/offset must run from 0 to " << s);
+  for (size_t i = 0; i < l; ++i) {
+    JVL_CHECK(imls_n[i] >= 0 && imls_c[i] >= 0 && static_cast<size_t>(imls_n[i]) < k &&
+                  static_cast<size_t>(imls_c[i]) < k,
+              what << ": imls correspondence " << i << " refers to keyframe rows " << imls_n[i]
+                   << ", " << imls_c[i] << " (have " << k << ")");
+  }
+  CheckSize(stats_visual_residuals, stats_frame.size(), "stats/visual_residuals", what);
+  CheckSize(stats_imls_residuals, stats_frame.size(), "stats/imls_residuals", what);
+  CheckSize(stats_cost_before, stats_frame.size(), "stats/cost_before", what);
+  CheckSize(stats_cost_after, stats_frame.size(), "stats/cost_after", what);
+  CheckSize(stats_time_ms, stats_frame.size(), "stats/time_ms", what);
+  CheckSize(stats_frame, k, "stats/frame", what);
+}
+
+void WriteLocalMap(const std::string& path, const LocalMapData& d, const Provenance& provenance) {
+  d.Check(path);
+  const int64_t l = static_cast<int64_t>(d.num_correspondences());
+  const int64_t s = static_cast<int64_t>(d.num_scan_points());
+  H5Writer w(path, kLocalSchema, kLocalSchemaVersion);
+  const PinholeCamera& c = d.camera;
+  w.WriteArray<double>("camera", {c.fx, c.fy, c.cx, c.cy, static_cast<double>(c.width),
+                                  static_cast<double>(c.height)});
+  WriteTrajectoryGroup(w, "keyframes", d.keyframes);
+  w.WriteArray("imls/n", d.imls_n);
+  w.WriteArray("imls/c", d.imls_c);
+  w.WriteArray("imls/p_x", d.imls_p_x, {l, 3});
+  w.WriteArray("imls/p_y", d.imls_p_y, {l, 3});
+  w.WriteArray("imls/normal", d.imls_normal, {l, 3});
+  w.WriteArray("mappoints/position", d.mappoint_position,
+               {static_cast<int64_t>(d.num_mappoints()), 3});
+  w.WriteArray("scans/offset", d.scan_offset);
+  w.WriteArray("scans/points", d.scan_points, {s, 3});
+  w.WriteArray("scans/normals", d.scan_normals, {s, 3});
+  w.WriteArray("stats/frame", d.stats_frame);
+  w.WriteArray("stats/visual_residuals", d.stats_visual_residuals);
+  w.WriteArray("stats/imls_residuals", d.stats_imls_residuals);
+  w.WriteArray("stats/cost_before", d.stats_cost_before);
+  w.WriteArray("stats/cost_after", d.stats_cost_after);
+  w.WriteArray("stats/time_ms", d.stats_time_ms);
+  WriteTrajectoryGroup(w, "prior", d.prior);
+  w.WriteJson("summary", d.summary);
+  w.Commit(provenance);
+}
+
+LocalMapData ReadLocalMap(const std::string& path) {
+  H5Reader r(path, kLocalSchema, kLocalSchemaVersion);
+  LocalMapData d;
+  const auto cam = r.ReadArray<double>("camera");
+  JVL_CHECK(cam.size() == 6, path << ": camera must have 6 values, has " << cam.size());
+  d.camera = {cam[0], cam[1], cam[2], cam[3], static_cast<int>(cam[4]), static_cast<int>(cam[5])};
+  d.keyframes = ReadTrajectoryGroup(r, "keyframes");
+  d.imls_n = r.ReadArray<int32_t>("imls/n");
+  d.imls_c = r.ReadArray<int32_t>("imls/c");
+  d.imls_p_x = r.ReadArray<double>("imls/p_x", 3);
+  d.imls_p_y = r.ReadArray<double>("imls/p_y", 3);
+  d.imls_normal = r.ReadArray<double>("imls/normal", 3);
+  d.mappoint_position = r.ReadArray<double>("mappoints/position", 3);
+  d.scan_offset = r.ReadArray<int64_t>("scans/offset");
+  d.scan_points = r.ReadArray<float>("scans/points", 3);
+  d.scan_normals = r.ReadArray<float>("scans/normals", 3);
+  d.stats_frame = r.ReadArray<int64_t>("stats/frame");
+  d.stats_visual_residuals = r.ReadArray<int32_t>("stats/visual_residuals");
+  d.stats_imls_residuals = r.ReadArray<int32_t>("stats/imls_residuals");
+  d.stats_cost_before = r.ReadArray<double>("stats/cost_before");
+  d.stats_cost_after = r.ReadArray<double>("stats/cost_after");
+  d.stats_time_ms = r.ReadArray<double>("stats/time_ms");
+  d.prior = ReadTrajectoryGroup(r, "prior");
+  d.summary = r.ReadJson("summary");
+  d.Check(path);
+  return d;
+}
+
+}  // namespace jvl::io

@@ -1,0 +1,58 @@
+// The "local" artifact (schema "local" v1, schemas/local.schema.json) written by local_map
+// (paper Sec. 4.2) and read by global optimisation:
+//
+//   camera double[6] (fx fy cx cy width height)
+//   keyframes/{frames, poses}        trajectory group: refined poses, same rows as visual.h5
+//   imls/{n int32[L], c int32[L], p_x double[L,3], p_y double[L,3], normal double[L,3]}
+//                                    the saved correspondence set L (keyframe rows; p_x in n's
+//                                    cam frame, p_y and normal in c's cam frame)
+//   mappoints/position double[M,3]   refined, same rows as visual.h5 mappoints
+//   scans/{offset int64[K+1], points float[S,3], normals float[S,3]}
+//                                    per keyframe the preprocessed, downsampled scan (own frame)
+//   stats/{frame int64[K], visual_residuals int32[K], imls_residuals int32[K],
+//          cost_before double[K], cost_after double[K], time_ms double[K]}
+//   prior/{frames, poses, timestamps}  the full prior trajectory
+//   attribute "summary" (JSON)
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "geometry/trajectory.h"
+#include "io/artifact.h"
+
+namespace jvl::io {
+
+inline constexpr const char* kLocalSchema = "local";
+inline constexpr int kLocalSchemaVersion = 1;
+
+// Flat arrays laid out exactly as in the file (row-major).
+struct LocalMapData {
+  PinholeCamera camera;
+  Trajectory keyframes;  // Refined world_from_cam0 of each keyframe.
+  std::vector<int32_t> imls_n, imls_c;
+  std::vector<double> imls_p_x, imls_p_y, imls_normal;  // L x 3 each.
+  std::vector<double> mappoint_position;                 // M x 3.
+  std::vector<int64_t> scan_offset;                      // K + 1, rows of scan_points.
+  std::vector<float> scan_points, scan_normals;          // S x 3 each.
+  std::vector<int64_t> stats_frame;
+  std::vector<int32_t> stats_visual_residuals, stats_imls_residuals;
+  std::vector<double> stats_cost_before, stats_cost_after, stats_time_ms;
+  Trajectory prior;
+  nlohmann::json summary = nlohmann::json::object();
+
+  size_t num_correspondences() const { return imls_n.size(); }
+  size_t num_mappoints() const { return mappoint_position.size() / 3; }
+  size_t num_scan_points() const { return scan_points.size() / 3; }
+  // Sizes agree and indices are in range; throws naming `what`.
+  void Check(const std::string& what) const;
+};
+
+void WriteLocalMap(const std::string& path, const LocalMapData& data,
+                   const Provenance& provenance);
+LocalMapData ReadLocalMap(const std::string& path);
+
+}  // namespace jvl::io

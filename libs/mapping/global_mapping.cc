@@ -1,0 +1,301 @@
+// Global joint optimisation (Sec. 4.3): problem assembly, fresh IMLS traversal, map export.
+#include "mapping/global_mapping.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+#include "core/check.h"
+#include "core/threads.h"
+#include "core/timer.h"
+#include "lidar/imls.h"
+#include "lidar/surface.h"
+#include "lidar/voxel_grid.h"
+
+namespace jvl::mapping {
+
+void GlobalMapInput::Check() const {
+  keyframes.Check("global input keyframes");
+  const int64_t k = static_cast<int64_t>(keyframes.size());
+  JVL_CHECK(k > 0, "global optimisation needs at least one keyframe");
+  JVL_CHECK(scans.empty() || static_cast<int64_t>(scans.size()) == k,
+            "scans: " << scans.size() << " entries for " << k << " keyframes");
+  for (size_t i = 0; i < scans.size(); ++i)
+    JVL_CHECK(scans[i].points.size() == scans[i].normals.size(),
+              "scan of keyframe row " << i << ": " << scans[i].points.size() << " points, "
+                                      << scans[i].normals.size() << " normals");
+  for (const auto& o : observations)
+    JVL_CHECK(o.keyframe >= 0 && o.keyframe < k && o.map_point >= 0 &&
+                  o.map_point < static_cast<int32_t>(map_points.size()),
+              "observation of keyframe row " << o.keyframe << " / map point " << o.map_point
+                                             << " out of range");
+  for (const auto& l : saved_imls)
+    JVL_CHECK(l.n >= 0 && l.n < k && l.c >= 0 && l.c < k,
+              "IMLS correspondence (" << l.n << ", " << l.c << ") out of range");
+}
+
+void ImlsTraversalOptions::Check() const {
+  JVL_CHECK(scan_map_frames >= 1, "scan_map_frames (N) must be >= 1, got " << scan_map_frames);
+  JVL_CHECK(samples_per_list >= 0, "samples_per_list must be >= 0");
+  JVL_CHECK(kernel_h > 0 && search_radius > 0 && max_distance > 0,
+            "IMLS kernel_h, search_radius and max_distance must be > 0");
+}
+
+void GlobalMappingOptions::Check() const {
+  joint.Check();
+  solve.Check();
+  traversal.Check();
+  JVL_CHECK(rounds >= 1, "rounds must be >= 1, got " << rounds);
+  JVL_CHECK(first_direction_round >= 0, "first_direction_round must be >= 0");
+}
+
+DirectionSelection SelectDirections(const Trajectory& keyframes,
+                                    const std::vector<DirectionAssociation>& associations) {
+  DirectionSelection out;
+  for (const auto& a : associations) {
+    const auto row = keyframes.IndexOf(a.frame);
+    if (!row) {
+      ++out.not_keyframe;
+      continue;
+    }
+    // A VP at infinity has no finite pixel v for Eq. (6); it is skipped (docs/global_opt.md).
+    if (!a.uv.allFinite()) {
+      ++out.at_infinity;
+      continue;
+    }
+    JVL_CHECK(a.direction_world.allFinite() && a.direction_world.norm() > 0.5,
+              "direction prior of cluster " << a.cluster << " (frame " << a.frame
+                                            << ") is not a unit vector");
+    out.constraints.push_back({static_cast<int64_t>(*row), a.uv, a.direction_world.normalized()});
+  }
+  return out;
+}
+
+namespace {
+
+// First model keyframe for keyframe n (local mapping step 2): the first i with f_n - f_i <= N,
+// but always at least n - 1 so that sparse keyframes still get a model.
+size_t ModelStart(const Trajectory& keyframes, size_t n, int scan_map_frames) {
+  size_t start = n - 1;
+  while (start > 0 && keyframes.frames[n] - keyframes.frames[start - 1] <= scan_map_frames) --start;
+  return start;
+}
+
+void AddToModel(const Trajectory& keyframes, const std::vector<KeyframeScan>& scans, size_t i,
+                lidar::ImlsModel* model) {
+  const Rigid3d& world_from_i = keyframes.world_from_cam[i];
+  std::vector<Eigen::Vector3d> wp, wn;
+  for (size_t j = 0; j < scans[i].points.size(); ++j) {
+    if (scans[i].normals[j].squaredNorm() < 0.25) continue;
+    wp.push_back(world_from_i * scans[i].points[j]);
+    wn.push_back(world_from_i.rotation() * scans[i].normals[j]);
+  }
+  model->AddScan(static_cast<int64_t>(i), wp, wn);
+}
+
+// Steps 3-4 for keyframe n against `model` (the scans of its window, current poses).
+std::vector<optim::ImlsCorrespondence> TraverseKeyframe(const Trajectory& keyframes,
+                                                        const std::vector<KeyframeScan>& scans,
+                                                        size_t n, const lidar::ImlsModel& model,
+                                                        const ImlsTraversalOptions& options,
+                                                        int threads) {
+  std::vector<optim::ImlsCorrespondence> out;
+  const KeyframeScan& scan = scans[n];
+  if (scan.points.empty() || model.size() == 0) return out;
+  // IMLS-SLAM sampling on the stored normals (planarity taken as 1: the stored scan keeps
+  // only points that had a normal).
+  lidar::ScanSurface surface;
+  surface.points = scan.points;
+  surface.normals = scan.normals;
+  surface.planarity.assign(scan.points.size(), 1.0);
+  surface.valid.resize(scan.points.size());
+  for (size_t j = 0; j < scan.points.size(); ++j)
+    surface.valid[j] = scan.normals[j].squaredNorm() >= 0.25 ? 1 : 0;
+  const size_t per_list = static_cast<size_t>(options.samples_per_list);
+  const auto lists = lidar::SamplingLists(surface, 20 * per_list);
+  const Rigid3d& world_from_n = keyframes.world_from_cam[n];
+  const auto samples =
+      lidar::SelectSamples(lists, scan.points.size(), options.samples_per_list, [&](int j) {
+        return model.HasNeighbor(world_from_n * scan.points[j], options.search_radius);
+      });
+  std::vector<uint8_t> ok(samples.size(), 0);
+  std::vector<optim::ImlsCorrespondence> found(samples.size());
+  ParallelFor(static_cast<int64_t>(samples.size()), threads, [&](int64_t s) {
+    const int j = samples[s];
+    lidar::ImlsProjection proj;
+    if (!model.Project(world_from_n * scan.points[j], options.kernel_h, options.search_radius,
+                       &proj))
+      return;
+    if (std::abs(proj.distance) > options.max_distance || proj.nearest_scan < 0) return;
+    const size_t c = static_cast<size_t>(proj.nearest_scan);
+    const Rigid3d cam_from_world = keyframes.world_from_cam[c].Inverse();
+    optim::ImlsCorrespondence& l = found[s];
+    l.n = static_cast<int64_t>(n);
+    l.c = static_cast<int64_t>(c);
+    l.p_x = scan.points[j];
+    l.c_p_y = cam_from_world * proj.projection;  // ^c p_y = T_cw p_y (step 4)
+    l.c_normal = (cam_from_world.rotation() * proj.normal).normalized();
+    ok[s] = 1;
+  });
+  for (size_t s = 0; s < samples.size(); ++s)
+    if (ok[s]) out.push_back(found[s]);
+  return out;
+}
+
+}  // namespace
+
+std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
+                                                    const std::vector<KeyframeScan>& scans,
+                                                    const ImlsTraversalOptions& options,
+                                                    int threads) {
+  options.Check();
+  JVL_CHECK(scans.size() == keyframes.size(),
+            "TraverseImls: " << scans.size() << " scans for " << keyframes.size() << " keyframes");
+  // The model of keyframe n holds the scans of keyframes ModelStart(n)..n-1 at the current
+  // poses; consecutive keyframes share most of it, so it slides (each scan is added once).
+  lidar::ImlsModel model(options.search_radius);
+  std::vector<optim::ImlsCorrespondence> out;
+  const int workers = ResolveThreadCount(threads);
+  size_t next = 0;  // next scan to add
+  for (size_t n = 1; n < keyframes.size(); ++n) {
+    const size_t start = ModelStart(keyframes, n, options.scan_map_frames);
+    for (const int64_t id : model.scan_ids())
+      if (static_cast<size_t>(id) < start) model.RemoveScan(id);
+    for (next = std::max(next, start); next < n; ++next) AddToModel(keyframes, scans, next, &model);
+    const auto l = TraverseKeyframe(keyframes, scans, n, model, options, workers);
+    out.insert(out.end(), l.begin(), l.end());
+  }
+  return out;
+}
+
+GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
+                                   const GlobalMappingOptions& options) {
+  const Timer total;
+  options.Check();
+  input.Check();
+  GlobalMappingResult result;
+  optim::JointProblemInput problem;
+  problem.camera = input.camera;
+  problem.fixed = {0};  // gauge: the first keyframe
+  problem.map_points = input.map_points;
+  problem.observations = input.observations;
+  const DirectionSelection dirs = SelectDirections(input.keyframes, input.directions);
+  result.directions_not_keyframe = dirs.not_keyframe;
+  result.directions_at_infinity = dirs.at_infinity;
+  if (options.use_directions)
+    result.directions_used = static_cast<int64_t>(dirs.constraints.size());
+  result.keyframes = input.keyframes;
+  const bool fresh = options.fresh_traversal && !input.scans.empty();
+  const int rounds = fresh ? options.rounds : 1;
+  optim::JointCostBreakdown first_before;
+  for (int round = 0; round < rounds; ++round) {
+    for (size_t i = 0; i < result.keyframes.size(); ++i)
+      problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
+    problem.directions.clear();
+    if (options.use_directions && round >= std::min(options.first_direction_round, rounds - 1))
+      problem.directions = dirs.constraints;
+    problem.imls.clear();
+    if (options.use_saved_imls) problem.imls = input.saved_imls;
+    result.saved_imls = static_cast<int64_t>(problem.imls.size());
+    if (fresh) {
+      // Eq. (3) against the current poses (the paper's single traversal in round 0).
+      const Timer t;
+      const auto l =
+          TraverseImls(result.keyframes, input.scans, options.traversal, options.solve.threads);
+      problem.imls.insert(problem.imls.end(), l.begin(), l.end());
+      result.fresh_imls = static_cast<int64_t>(l.size());
+      result.traversal_time_s += t.ElapsedSeconds();
+    }
+    if (round == 0 && options.use_directions && problem.directions.empty()) {
+      // Warm-start round without e_D: report the full energy at the input poses anyway.
+      optim::JointProblemInput full = problem;
+      full.directions = dirs.constraints;
+      auto built = optim::BuildJointProblem(full, options.joint);
+      first_before = optim::EvaluateJointCost(built, options.solve.threads);
+    }
+    result.solve = optim::OptimizeJoint(problem, options.joint, options.solve);
+    ++result.rounds;
+    result.total_iterations += result.solve.iterations;
+    if (round == 0 && first_before.total == 0.0) first_before = result.solve.before;
+    if (!result.solve.usable) {
+      spdlog::warn(
+          "global optimisation round {} failed ({}); keyframes keep the poses of the "
+          "previous round",
+          round, result.solve.termination);
+      break;
+    }
+    for (size_t i = 0; i < result.keyframes.size(); ++i)
+      result.keyframes.world_from_cam[i] = result.solve.poses.at(static_cast<int64_t>(i));
+    problem.map_points = result.solve.map_points;
+  }
+  result.solve.before = first_before;  // report the costs at the input poses
+  result.total_time_s = total.ElapsedSeconds();
+  return result;
+}
+
+namespace {
+
+nlohmann::json StatsOf(const optim::ResidualStats& s) {
+  return {{"count", s.count}, {"cost", s.cost}, {"rms", s.rms}};
+}
+
+nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
+  return {{"visual", StatsOf(b.visual)},
+          {"imls", StatsOf(b.imls)},
+          {"direction", StatsOf(b.direction)},
+          {"total", b.total}};
+}
+
+}  // namespace
+
+nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMappingOptions& o) {
+  const auto& s = r.solve;
+  return {{"before", BreakdownOf(s.before)},
+          {"after", BreakdownOf(s.after)},
+          {"weights",
+           {{"alpha", s.weights.alpha}, {"beta", s.weights.beta}, {"gamma", s.weights.gamma}}},
+          {"weights_from_rule", {{"beta", o.joint.beta <= 0}, {"gamma", o.joint.gamma <= 0}}},
+          {"imls", {{"saved", r.saved_imls}, {"fresh", r.fresh_imls}}},
+          {"directions",
+           {{"used", r.directions_used},
+            {"not_keyframe", r.directions_not_keyframe},
+            {"at_infinity", r.directions_at_infinity},
+            {"enabled", o.use_directions}}},
+          {"solver",
+           {{"usable", s.usable},
+            {"iterations", r.total_iterations},
+            {"rounds", r.rounds},
+            {"last_round_iterations", s.iterations},
+            {"time_s", s.time_s},
+            {"termination", s.termination},
+            {"linear_solver", s.linear_solver},
+            {"threads", o.solve.threads},
+            {"max_iterations", o.solve.max_iterations}}},
+          {"traversal_time_s", r.traversal_time_s},
+          {"total_time_s", r.total_time_s}};
+}
+
+std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,
+                                           const std::vector<KeyframeScan>& scans,
+                                           double voxel_size) {
+  JVL_CHECK(scans.size() == keyframes.size(),
+            "AccumulateMap: " << scans.size() << " scans for " << keyframes.size() << " keyframes");
+  std::vector<Eigen::Vector3f> out;
+  std::unordered_set<uint64_t, lidar::CellHash> occupied;
+  const double inv = voxel_size > 0 ? 1.0 / voxel_size : 0.0;
+  for (size_t k = 0; k < scans.size(); ++k) {
+    for (const Eigen::Vector3d& p : scans[k].points) {
+      const Eigen::Vector3d w = keyframes.world_from_cam[k] * p;
+      if (voxel_size > 0) {
+        const Eigen::Vector3i c = lidar::CellOf(w, inv);
+        if (!occupied.insert(lidar::PackCell(c.x(), c.y(), c.z())).second) continue;
+      }
+      out.push_back(w.cast<float>());
+    }
+  }
+  return out;
+}
+
+}  // namespace jvl::mapping

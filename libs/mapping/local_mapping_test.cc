@@ -1,0 +1,192 @@
+#include "mapping/local_mapping.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "mapping/local_test_scene.h"
+#include "mapping/local_test_util.h"
+#include "optim/cost_functions.h"
+
+namespace jvl::mapping {
+namespace {
+
+using testing::DriftingPrior;
+using testing::RoadPoses;
+using testing::SampleScan;
+using testing::StreetPatches;
+
+const PinholeCamera kCamera{718.856, 718.856, 607.1928, 185.2157, 1226, 370};
+
+TEST(LocalMapping, StartKeyframeIsFirstWithinNFrames) {
+  const std::vector<int64_t> frames{0, 3, 5, 9, 12, 20};
+  EXPECT_EQ(StartKeyframe(frames, 0, 10, 1), 0u);  // Nothing before the first keyframe.
+  EXPECT_EQ(StartKeyframe(frames, 4, 10, 1), 1u);  // 12 - 3 <= 10 < 12 - 0.
+  EXPECT_EQ(StartKeyframe(frames, 3, 10, 1), 0u);  // 9 - 0 <= 10.
+  EXPECT_EQ(StartKeyframe(frames, 5, 10, 1), 4u);  // 20 - 12 <= 10 < 20 - 9.
+  EXPECT_EQ(StartKeyframe(frames, 5, 8, 1), 4u);   // Boundary: f_n - f_i == N is inside.
+  EXPECT_EQ(StartKeyframe(frames, 5, 7, 0), 5u);   // Literal rule: empty S_model.
+  EXPECT_EQ(StartKeyframe(frames, 5, 7, 1), 4u);   // At least the previous keyframe.
+  EXPECT_EQ(StartKeyframe(frames, 5, 7, 2), 3u);
+  EXPECT_EQ(StartKeyframe(frames, 1, 1, 3), 0u);   // Cannot go before row 0.
+}
+
+TEST(LocalMapping, LocalKeyframesAreCovisibleEarlierOnesByTime) {
+  const auto adj = CovisibilityAdjacency(6, {{0, 1}, {1, 2}, {2, 4}, {3, 4}, {4, 5}, {1, 2}});
+  EXPECT_EQ(LocalKeyframes(4, adj), (std::vector<int64_t>{2, 3, 4}));  // 5 has not arrived.
+  EXPECT_EQ(LocalKeyframes(0, adj), (std::vector<int64_t>{0}));
+  EXPECT_EQ(LocalKeyframes(1, adj), (std::vector<int64_t>{0, 1}));
+  EXPECT_EQ(adj[1], (std::vector<int>{0, 2}));  // Duplicate edge merged.
+}
+
+TEST(LocalMapping, SavedCorrespondencesReusedOnlyWithinLocal) {
+  std::vector<optim::ImlsCorrespondence> saved(5);
+  const int64_t pairs[5][2] = {{1, 0}, {2, 1}, {4, 2}, {4, 3}, {3, 1}};
+  for (int i = 0; i < 5; ++i) {
+    saved[i].n = pairs[i][0];
+    saved[i].c = pairs[i][1];
+  }
+  EXPECT_EQ(ReusableCorrespondences(saved, {2, 3, 4}), (std::vector<size_t>{2, 3}));
+  EXPECT_EQ(ReusableCorrespondences(saved, {0, 1, 2}), (std::vector<size_t>{0, 1}));
+  EXPECT_TRUE(ReusableCorrespondences(saved, {4}).empty());  // Needs both keyframes.
+}
+
+TEST(LocalMapping, GaugeFixesFirstKeyframeAndNonLocalPoses) {
+  EXPECT_EQ(FixedKeyframes({2, 3, 4}, {1, 2, 3, 4}), (std::set<int64_t>{1}));
+  EXPECT_EQ(FixedKeyframes({2, 3, 4}, {2, 3, 4}), (std::set<int64_t>{2}));  // Oldest local.
+  EXPECT_EQ(FixedKeyframes({0, 1, 2}, {0, 1, 2}), (std::set<int64_t>{0}));
+  EXPECT_EQ(FixedKeyframes({5}, {3, 4, 5}), (std::set<int64_t>{3, 4}));
+}
+
+// Scans sampled from exact planes: at the true poses every sampled point lies on the IMLS
+// surface, so every new residual of Eq. (3) is zero.
+TEST(LocalMapping, ImlsResidualIsZeroAtTrueConfiguration) {
+  const auto patches = StreetPatches();
+  const std::vector<Rigid3d> truth = RoadPoses(4, 4.5, 0.01);
+  std::vector<KeyframeScan> scans;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    std::vector<Eigen::Vector3d> p, n;
+    SampleScan(patches, truth[k], 0.3, 40, 11 + static_cast<uint32_t>(k), &p, &n);
+    scans.push_back(KeyframeScanFromSurface(p, n, 0.3));
+  }
+  const lidar::ImlsModel model =
+      BuildScanModel({&scans[0], &scans[1], &scans[2]}, {0, 1, 2}, truth, 0.6);
+  const auto corr = AssociateScan(3, scans[3], truth[3], model, truth, AssociationOptions());
+  ASSERT_GT(corr.size(), 500u);
+  std::map<int64_t, int> per_c;
+  double max_abs = 0;
+  for (const auto& l : corr) {
+    EXPECT_EQ(l.n, 3);
+    ASSERT_GE(l.c, 0);
+    ASSERT_LE(l.c, 2);
+    ++per_c[l.c];
+    const optim::PointToImlsCost cost(l.p_x, l.c_p_y, l.c_normal, 1.0);
+    const auto bn = truth[3].ToArray();
+    const auto bc = truth[static_cast<size_t>(l.c)].ToArray();
+    double r = 0;
+    cost(bn.data(), bc.data(), &r);
+    max_abs = std::max(max_abs, std::abs(r));
+    EXPECT_NEAR(l.c_normal.norm(), 1.0, 1e-12);
+  }
+  EXPECT_LT(max_abs, 1e-9);
+  EXPECT_GE(per_c.size(), 2u);  // c is the keyframe of the nearest model point, not always one.
+  // Away from the truth the same correspondences are violated.
+  const Rigid3d moved = truth[3] * Rigid3d(Eigen::Quaterniond::Identity(), {0.1, -0.05, 0.2});
+  const auto shifted = AssociateScan(3, scans[3], moved, model, truth, AssociationOptions());
+  double sum = 0;
+  for (const auto& l : shifted) {
+    const optim::PointToImlsCost cost(l.p_x, l.c_p_y, l.c_normal, 1.0);
+    const auto bn = moved.ToArray();
+    const auto bc = truth[static_cast<size_t>(l.c)].ToArray();
+    double r = 0;
+    cost(bn.data(), bc.data(), &r);
+    sum += r * r;
+  }
+  EXPECT_GT(std::sqrt(sum / static_cast<double>(shifted.size())), 0.03);
+}
+
+struct SyntheticRun {
+  std::vector<Rigid3d> truth, prior;
+  LocalMappingInput input;
+  LocalMappingResult result;
+};
+
+SyntheticRun RunSynthetic(int keyframes, double yaw_drift, double scale,
+                          const LocalMappingOptions& options) {
+  SyntheticRun run;
+  run.truth = RoadPoses(keyframes, 4.5, 0.004);
+  run.prior = DriftingPrior(run.truth, yaw_drift, scale);
+  std::vector<int64_t> frames;
+  for (int k = 0; k < keyframes; ++k) frames.push_back(3 * k);
+  run.input = testing::MakeVisualInput(kCamera, run.truth, run.prior, frames, 1500, 0.5, 7);
+  const auto patches = StreetPatches();
+  run.result = RunLocalMapping(
+      run.input,
+      [&](size_t row) {
+        std::vector<Eigen::Vector3d> p, n;
+        SampleScan(patches, run.truth[row], 0.3, 40, 100 + static_cast<uint32_t>(row), &p, &n);
+        return KeyframeScanFromSurface(p, n, 0.5);
+      },
+      options, 2);
+  return run;
+}
+
+TEST(LocalMapping, SyntheticDriftingPriorIsCorrected) {
+  LocalMappingOptions options;
+  const SyntheticRun run = RunSynthetic(20, 0.01, 1.04, options);
+  const double prior_ape = testing::KeyframeApe(run.prior, run.truth);
+  const double local_ape = testing::KeyframeApe(run.result.poses, run.truth);
+  std::printf("synthetic drift: keyframe APE prior %.3f m -> local %.3f m\n", prior_ape, local_ape);
+  EXPECT_GT(prior_ape, 1.0);
+  EXPECT_LE(local_ape, 0.5 * prior_ape);
+  EXPECT_LT(local_ape, 0.2);
+  // The first keyframe is the gauge.
+  EXPECT_LT((run.result.poses[0].translation() - run.truth[0].translation()).norm(), 1e-12);
+  // Bookkeeping: L holds every keyframe's new correspondences in arrival order; the reused
+  // count of keyframe n is what L held before n with both keyframes in K_local(n).
+  const auto adj = CovisibilityAdjacency(run.input.size(), run.input.covisibility);
+  size_t offset = 0;
+  for (size_t n = 0; n < run.input.size(); ++n) {
+    const KeyframeStats& s = run.result.stats[n];
+    const auto local = LocalKeyframes(n, adj);
+    const std::set<int64_t> local_set(local.begin(), local.end());
+    int reusable = 0;
+    for (size_t i = 0; i < offset; ++i) {
+      const auto& l = run.result.correspondences[i];
+      ASSERT_LT(l.n, static_cast<int64_t>(n));
+      reusable += local_set.count(l.n) && local_set.count(l.c);
+    }
+    EXPECT_EQ(s.reused_correspondences, reusable) << "keyframe " << n;
+    EXPECT_EQ(s.imls_residuals, s.new_correspondences + s.reused_correspondences);
+    const size_t start = StartKeyframe(run.input.frames, n, options.scan_map_size, 1);
+    for (int i = 0; i < s.new_correspondences; ++i) {
+      const auto& l = run.result.correspondences[offset + static_cast<size_t>(i)];
+      ASSERT_EQ(l.n, static_cast<int64_t>(n));
+      ASSERT_GE(l.c, static_cast<int64_t>(start));
+      ASSERT_LT(l.c, static_cast<int64_t>(n));
+    }
+    offset += static_cast<size_t>(s.new_correspondences);
+    if (n > 0) {
+      EXPECT_GT(s.new_correspondences, 100) << "keyframe " << n;
+    }
+  }
+  EXPECT_EQ(offset, run.result.correspondences.size());
+}
+
+TEST(LocalMapping, ExactPriorStaysPut) {
+  const SyntheticRun run = RunSynthetic(8, 0.0, 1.0, LocalMappingOptions());
+  for (size_t k = 0; k < run.truth.size(); ++k) {
+    EXPECT_LT((run.result.poses[k].translation() - run.truth[k].translation()).norm(), 0.02);
+    EXPECT_LT(RotationAngle(run.result.poses[k].rotation() * run.truth[k].rotation().inverse()),
+              1e-3);
+  }
+  const io::LocalMapData data = ExportLocalMap(run.input, run.result, Trajectory(), {});
+  EXPECT_EQ(data.keyframes.size(), 8u);
+  EXPECT_EQ(data.scan_offset.size(), 9u);
+  EXPECT_EQ(data.num_correspondences(), run.result.correspondences.size());
+  EXPECT_EQ(data.num_mappoints(), run.input.map_points.size());
+}
+
+}  // namespace
+}  // namespace jvl::mapping

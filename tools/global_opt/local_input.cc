@@ -1,0 +1,40 @@
+#include "local_input.h"
+
+#include "core/check.h"
+#include "io/local_io.h"
+
+namespace jvl::global_opt {
+
+namespace {
+
+template <typename T>
+Eigen::Vector3d Row3(const std::vector<T>& a, size_t i) {
+  return Eigen::Vector3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+}
+
+}  // namespace
+
+LocalInput ToLocalInput(const io::LocalMapData& d) {
+  LocalInput out;
+  out.keyframes = d.keyframes;
+  const size_t k = d.keyframes.size();
+  for (size_t i = 0; i < d.num_correspondences(); ++i)
+    out.imls.push_back({d.imls_n[i], d.imls_c[i], Row3(d.imls_p_x, i), Row3(d.imls_p_y, i),
+                        Row3(d.imls_normal, i).normalized()});
+  for (size_t i = 0; i < d.num_mappoints(); ++i)
+    out.mappoints.push_back(Row3(d.mappoint_position, i));
+  if (!d.scan_offset.empty()) {
+    out.scans.resize(k);
+    for (size_t i = 0; i < k; ++i)
+      for (int64_t j = d.scan_offset[i]; j < d.scan_offset[i + 1]; ++j) {
+        out.scans[i].points.push_back(Row3(d.scan_points, static_cast<size_t>(j)));
+        out.scans[i].normals.push_back(Row3(d.scan_normals, static_cast<size_t>(j)));
+      }
+  }
+  out.prior = d.prior;
+  return out;
+}
+
+LocalInput ReadLocalInput(const std::string& path) { return ToLocalInput(io::ReadLocalMap(path)); }
+
+}  // namespace jvl::global_opt

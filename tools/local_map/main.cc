@@ -1,0 +1,79 @@
+// local_map: joint visual + point-to-IMLS optimisation per keyframe (paper Sec. 4.2,
+// supplement 1.2) over the visual map of visual_assoc and the dataset's scans.
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "app/tool.h"
+#include "cli_options.h"
+#include "core/progress.h"
+#include "io/dataset.h"
+#include "io/local_io.h"
+#include "io/trajectory_io.h"
+#include "io/visual_io.h"
+#include "mapping/local_mapping.h"
+
+int main(int argc, char** argv) {
+  using namespace jvl;
+  app::Tool tool("local_map",
+                 "Refine keyframe poses and map points by joint visual / point-to-IMLS local "
+                 "optimisation of each keyframe.");
+  std::string visual_path, dataset_dir, format = "auto", prior_path, output, kitti_poses;
+  mapping::LocalMappingOptions options;
+  mapping::ScanOptions scan_options;
+  auto& cli = tool.cli();
+  cli.add_option("--visual", visual_path, "visual.h5 from visual_assoc")->required();
+  cli.add_option("--dataset", dataset_dir, "Dataset folder (the scans)")->required();
+  cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--prior", prior_path,
+                 "Initial poses (.h5, KITTI or TUM); default: the visual artifact's prior");
+  cli.add_option("-o,--output", output, "Output local.h5")->required();
+  cli.add_option("--kitti-poses", kitti_poses, "Also write the refined keyframes as KITTI text");
+  tools::AddLocalMapFlags(cli, &options, &scan_options);
+  return tool.Run(argc, argv, [&] {
+    options.Check();
+    scan_options.Check();
+    const io::VisualMapData visual = io::ReadVisualMap(visual_path);
+    tool.AddInput(visual_path);
+    Trajectory prior = visual.prior;
+    if (!prior_path.empty()) {
+      prior = io::ReadTrajectory(prior_path);
+      tool.AddInput(prior_path);
+    }
+    const auto input = mapping::MakeLocalMappingInput(
+        visual, prior, prior_path.empty() ? visual_path + " (prior)" : prior_path);
+    auto dataset = io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), FrameRange());
+    tool.SetDatasetId(dataset->id());
+    for (const auto& f : dataset->KeyFiles()) tool.AddInput(f);
+    const Rigid3d cam0_from_velo = dataset->calibration().cam0_from_velo;
+    // Candidates per sampling list, as lidar_odom: sampling stops after s accepted points.
+    const size_t list_length = 20 * static_cast<size_t>(options.association.samples_per_list);
+    Progress progress("local_map", static_cast<int64_t>(input.size()), !tool.quiet());
+    const mapping::LocalMappingResult result = mapping::RunLocalMapping(
+        input,
+        [&](size_t row) {
+          const PointCloud scan = dataset->LoadScan(input.frames[row]);
+          return mapping::PrepareKeyframeScan(scan, cam0_from_velo, scan_options, list_length,
+                                              tool.threads());
+        },
+        options, tool.threads(),
+        [&](size_t, const mapping::KeyframeStats& s) {
+          spdlog::debug("keyframe {}: local {}, model {}, fixed {}, visual {}, imls {} ({} new, {} "
+                        "reused), cost {:.1f} -> {:.1f}, moved {:.3f} m, {:.0f} ms",
+                        s.frame, s.local_keyframes, s.model_keyframes, s.fixed_keyframes,
+                        s.visual_residuals, s.imls_residuals, s.new_correspondences,
+                        s.reused_correspondences, s.cost_before, s.cost_after, s.correction_m,
+                        s.time_ms);
+          progress.Tick();
+        });
+    const nlohmann::json summary = mapping::SummarizeLocalMap(result, options);
+    io::WriteLocalMap(output, mapping::ExportLocalMap(input, result, prior, summary),
+                      tool.MakeProvenance());
+    if (!kitti_poses.empty()) {
+      io::WriteTrajectoryKitti(kitti_poses, mapping::RefinedKeyframes(input, result));
+    }
+    std::printf("%s\n", summary.dump().c_str());
+    spdlog::info("local_map: {} keyframes, {:.0f} ms median per keyframe; wrote {}",
+                 input.size(), summary.at("median_time_ms").get<double>(), output);
+  });
+}
