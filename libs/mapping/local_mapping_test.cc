@@ -29,7 +29,7 @@ TEST(LocalMapping, StartKeyframeIsFirstWithinNFrames) {
   EXPECT_EQ(StartKeyframe(frames, 5, 7, 0), 5u);   // Literal rule: empty S_model.
   EXPECT_EQ(StartKeyframe(frames, 5, 7, 1), 4u);   // At least the previous keyframe.
   EXPECT_EQ(StartKeyframe(frames, 5, 7, 2), 3u);
-  EXPECT_EQ(StartKeyframe(frames, 1, 1, 3), 0u);   // Cannot go before row 0.
+  EXPECT_EQ(StartKeyframe(frames, 1, 1, 3), 0u);  // Cannot go before row 0.
 }
 
 TEST(LocalMapping, LocalKeyframesAreCovisibleEarlierOnesByTime) {
