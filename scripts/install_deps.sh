@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libopencv-dev libpcl-dev libceres-dev
   libcli11-dev nlohmann-json3-dev libhdf5-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev
-  libopencv-contrib-dev
+  libopencv-contrib-dev libembree-dev
   python3 python3-matplotlib python3-numpy
 )
 

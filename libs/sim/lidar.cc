@@ -1,0 +1,97 @@
+#include "sim/lidar.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+#include "sim/random.h"
+#include "sim/shading.h"
+
+namespace jvl::sim {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void LidarOptions::Check() const {
+  JVL_CHECK(beams >= 2 && beams <= 256, "LiDAR beams must be in [2, 256], got " << beams);
+  JVL_CHECK(elevation_max_deg > elevation_min_deg, "LiDAR elevation max must exceed min");
+  JVL_CHECK(azimuth_steps >= 16, "LiDAR azimuth steps must be >= 16");
+  JVL_CHECK(max_range > min_range && min_range >= 0, "LiDAR range limits are inconsistent");
+  JVL_CHECK(range_noise >= 0, "LiDAR range noise must be >= 0");
+  JVL_CHECK(dropout >= 0 && dropout < 1, "LiDAR dropout must be in [0, 1)");
+  JVL_CHECK(glass_dropout >= 0 && glass_dropout <= 1, "glass dropout must be in [0, 1]");
+  JVL_CHECK(sweep_period > 0, "sweep period must be positive");
+}
+
+std::vector<double> LidarOptions::ElevationsRad() const {
+  // Split point of the two laser blocks scaled from the HDL-64E's -8.33 / -8.83 deg.
+  const double span = elevation_max_deg - elevation_min_deg;
+  const double upper_end = elevation_max_deg - span * (10.33 / 26.9);
+  const double lower_start = elevation_max_deg - span * (10.83 / 26.9);
+  const int upper = beams / 2, lower = beams - upper;
+  std::vector<double> e;
+  for (int i = 0; i < upper; ++i) {
+    e.push_back(elevation_max_deg + (upper_end - elevation_max_deg) * i / std::max(1, upper - 1));
+  }
+  for (int i = 0; i < lower; ++i) {
+    e.push_back(lower_start + (elevation_min_deg - lower_start) * i / std::max(1, lower - 1));
+  }
+  for (double& x : e) x *= kPi / 180.0;
+  return e;
+}
+
+PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid3d& world_from_velo,
+                        const std::vector<Box>& moving, const LidarOptions& options, uint64_t seed,
+                        const SweepPose* sweep_pose) {
+  const std::vector<double> elev = options.ElevationsRad();
+  const int nb = static_cast<int>(elev.size()), na = options.azimuth_steps;
+  std::vector<double> ce(nb), se(nb);
+  for (int b = 0; b < nb; ++b) ce[b] = std::cos(elev[b]), se[b] = std::sin(elev[b]);
+  // Per slot: point in the frame-time velodyne frame, intensity, and validity.
+  std::vector<Eigen::Vector3f> pts(static_cast<size_t>(nb) * na);
+  std::vector<float> inten(pts.size());
+  std::vector<uint8_t> ok(pts.size(), 0);
+  Rng rng(seed);
+  const NormalTable normal;
+  for (int a = 0; a < na; ++a) {
+    const double az = kPi - 2 * kPi * a / na;  // Clockwise from behind.
+    Rigid3d pose = world_from_velo;
+    if (options.motion_distortion && sweep_pose != nullptr) {
+      pose = (*sweep_pose)(options.sweep_period * (static_cast<double>(a) / na - 0.5));
+    }
+    const Eigen::Matrix3d R = pose.RotationMatrix();
+    const Eigen::Vector3d o = pose.translation();
+    const double ca = std::cos(az), sa = std::sin(az);
+    for (int b = 0; b < nb; ++b) {
+      const Eigen::Vector3d d_velo(ce[b] * ca, ce[b] * sa, se[b]);
+      const Eigen::Vector3d d = R * d_velo;
+      Hit hit = caster.Intersect(o, d, 0.05, options.max_range);
+      IntersectBoxes(moving, o, d, &hit);
+      // Draw the random numbers for every slot so that the stream does not depend on hits.
+      const double u_drop = rng.Uniform(), u_glass = rng.Uniform(), noise = normal.Sample(rng);
+      const double n_int = normal.Sample(rng);
+      if (!hit.valid() || hit.t < options.min_range || hit.t > options.max_range) continue;
+      if (u_drop < options.dropout) continue;
+      const Eigen::Vector3d p = o + hit.t * d;
+      const Surface surf = ShadeSurface(scene, hit, p);
+      if (surf.glass && u_glass < options.glass_dropout) continue;
+      const double r = hit.t + options.range_noise * noise;
+      const size_t k = static_cast<size_t>(b) * na + a;
+      // The sensor reports the return in its own frame at firing time: with motion distortion
+      // the scan is not compensated for the motion during the sweep (as raw KITTI scans).
+      pts[k] = (r * d_velo).cast<float>();
+      const double incidence = std::abs(hit.normal.dot(d));
+      inten[k] = static_cast<float>(
+          std::clamp(surf.reflectance * (0.45 + 0.55 * incidence) + 0.02 * n_int, 0.0, 0.99));
+      ok[k] = 1;
+    }
+  }
+  PointCloud cloud;
+  for (size_t k = 0; k < pts.size(); ++k) {
+    if (!ok[k]) continue;
+    cloud.points.push_back(pts[k].cast<double>());
+    cloud.intensity.push_back(inten[k]);
+  }
+  return cloud;
+}
+
+}  // namespace jvl::sim

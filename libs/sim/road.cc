@@ -1,0 +1,276 @@
+#include "sim/road.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/check.h"
+#include "sim/random.h"
+
+namespace jvl::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+RoadPiece Straight(double length, double speed, bool open = false) {
+  RoadPiece p;
+  p.length = length;
+  p.speed = speed;
+  p.open = open;
+  return p;
+}
+
+// A turn of `angle_deg` (left positive) with the given radius.
+RoadPiece Turn(double angle_deg, double radius, double speed) {
+  RoadPiece p;
+  p.length = std::abs(angle_deg) * kPi / 180.0 * radius;
+  p.curvature = (angle_deg > 0 ? 1.0 : -1.0) / radius;
+  p.speed = speed;
+  return p;
+}
+
+RoadPoint PieceAt(const RoadPiece& p, int index, double ds) {
+  RoadPoint r;
+  r.piece = index;
+  r.curvature = p.curvature;
+  const double h0 = p.start_heading;
+  if (p.IsStraight()) {
+    r.position = p.start + ds * Eigen::Vector2d(std::cos(h0), std::sin(h0));
+    r.heading = h0;
+  } else {
+    const double k = p.curvature;
+    r.heading = h0 + k * ds;
+    r.position = p.start + Eigen::Vector2d((std::sin(r.heading) - std::sin(h0)) / k,
+                                           (std::cos(h0) - std::cos(r.heading)) / k);
+  }
+  return r;
+}
+
+}  // namespace
+
+Route::Route(std::vector<RoadPiece> pieces, const Eigen::Vector2d& start, double heading)
+    : pieces_(std::move(pieces)) {
+  JVL_CHECK(!pieces_.empty(), "route has no pieces");
+  Eigen::Vector2d p = start;
+  double h = heading;
+  for (size_t i = 0; i < pieces_.size(); ++i) {
+    RoadPiece& piece = pieces_[i];
+    JVL_CHECK(piece.length > 0, "route piece " << i << " has length " << piece.length);
+    piece.start = p;
+    piece.start_heading = h;
+    piece.s0 = length_;
+    const RoadPoint end = PieceAt(piece, static_cast<int>(i), piece.length);
+    Cache c;
+    c.dir = Eigen::Vector2d(std::cos(h), std::sin(h));
+    if (!piece.IsStraight()) {
+      c.centre = piece.start + Eigen::Vector2d(-c.dir.y(), c.dir.x()) / piece.curvature;
+      c.radius = 1.0 / std::abs(piece.curvature);
+    }
+    c.end = end.position;
+    c.end_heading = end.heading;
+    c.mid = PieceAt(piece, static_cast<int>(i), piece.length / 2).position;
+    cache_.push_back(c);
+    p = end.position;
+    h = end.heading;
+    length_ += piece.length;
+  }
+}
+
+RoadPoint Route::At(double s) const {
+  s = std::clamp(s, 0.0, length_);
+  size_t i = 0;
+  while (i + 1 < pieces_.size() && s > pieces_[i].s0 + pieces_[i].length) ++i;
+  return PieceAt(pieces_[i], static_cast<int>(i), s - pieces_[i].s0);
+}
+
+void Route::Project(const Eigen::Vector2d& p, double* s, double* lateral) const {
+  double best = std::numeric_limits<double>::infinity();
+  *s = 0;
+  *lateral = best;
+  for (size_t i = 0; i < pieces_.size(); ++i) {
+    const RoadPiece& piece = pieces_[i];
+    const Cache& c = cache_[i];
+    // Every point of the piece lies within length/2 of its mid point.
+    const double bound = std::max(0.0, (p - c.mid).norm() - piece.length / 2);
+    if (bound * bound >= best) continue;
+    double ds, lat;
+    bool inside;
+    if (piece.IsStraight()) {
+      const Eigen::Vector2d d = p - piece.start;
+      ds = d.dot(c.dir);
+      lat = c.dir.x() * d.y() - c.dir.y() * d.x();
+      inside = ds >= 0 && ds <= piece.length;
+    } else {
+      // p - centre = (1/k)(sin h, -cos h) scaled: recover the heading h of the nearest point.
+      const double k = piece.curvature;
+      const Eigen::Vector2d r = (p - c.centre) * (k > 0 ? 1.0 : -1.0);
+      ds = std::remainder(std::atan2(r.x(), -r.y()) - piece.start_heading, 2 * kPi) / k;
+      lat = (k > 0 ? 1.0 : -1.0) * (c.radius - r.norm());
+      inside = ds >= 0 && ds <= piece.length;
+    }
+    if (inside) {
+      if (lat * lat < best) {
+        best = lat * lat;
+        *s = piece.s0 + ds;
+        *lateral = lat;
+      }
+      continue;
+    }
+    // Off the piece: the nearer of its two ends.
+    const double d0 = (p - piece.start).squaredNorm(), d1 = (p - c.end).squaredNorm();
+    const bool at_end = d1 < d0;
+    const double dist2 = at_end ? d1 : d0;
+    if (dist2 < best) {
+      best = dist2;
+      *s = piece.s0 + (at_end ? piece.length : 0.0);
+      const double h = at_end ? c.end_heading : piece.start_heading;
+      const Eigen::Vector2d d = p - (at_end ? c.end : piece.start);
+      const double cross = std::cos(h) * d.y() - std::sin(h) * d.x();
+      *lateral = (cross >= 0 ? 1.0 : -1.0) * std::sqrt(dist2);
+    }
+  }
+}
+
+double Route::Distance(const Eigen::Vector2d& p) const {
+  double s, lateral;
+  Project(p, &s, &lateral);
+  return std::abs(lateral);
+}
+
+double Terrain::Height(double x, double y) const {
+  const double u[3] = {x, y, (x + y) * 0.7071};
+  double h = 0;
+  for (int i = 0; i < 3; ++i)
+    h += amplitude[i] * std::sin(2 * kPi * u[i] / wavelength[i] + phase[i]);
+  return h;
+}
+
+Eigen::Vector2d Terrain::Gradient(double x, double y) const {
+  const double u[3] = {x, y, (x + y) * 0.7071};
+  const Eigen::Vector2d du[3] = {{1, 0}, {0, 1}, {0.7071, 0.7071}};
+  Eigen::Vector2d g = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    const double w = 2 * kPi / wavelength[i];
+    g += amplitude[i] * w * std::cos(w * u[i] + phase[i]) * du[i];
+  }
+  return g;
+}
+
+Scenario ParseScenario(const std::string& name) {
+  if (name == "urban") return Scenario::kUrban;
+  if (name == "suburban") return Scenario::kSuburban;
+  if (name == "highway") return Scenario::kHighway;
+  JVL_THROW("unknown scenario '" << name << "' (expected urban, suburban or highway)");
+}
+
+std::string ToString(Scenario scenario) {
+  switch (scenario) {
+    case Scenario::kUrban:
+      return "urban";
+    case Scenario::kSuburban:
+      return "suburban";
+    case Scenario::kHighway:
+      return "highway";
+  }
+  return "?";
+}
+
+std::vector<RoadPiece> ScenarioRoute(Scenario scenario) {
+  switch (scenario) {
+    case Scenario::kUrban:
+      // ~471 m: two long straights, three 90-degree corners, one gentle bend, an open stretch.
+      return {Straight(130, 10.5),      Turn(90, 12, 5.0), Straight(110, 11.0), Turn(-30, 150, 9.0),
+              Straight(55, 11.5, true), Turn(90, 12, 5.0), Straight(60, 10.0)};
+    case Scenario::kSuburban:
+      return {Straight(120, 10.0),      Turn(-90, 15, 5.5), Straight(140, 11.0), Turn(45, 60, 8.0),
+              Straight(70, 11.0, true), Turn(-90, 15, 5.5), Straight(60, 10.0)};
+    case Scenario::kHighway:
+      return {Straight(320, 20.0), Turn(20, 600, 20.0), Straight(300, 21.0, true),
+              Turn(-15, 700, 20.0), Straight(200, 20.0)};
+  }
+  return {};
+}
+
+void DriveOptions::Check() const {
+  JVL_CHECK(frame_rate_hz > 0, "frame rate must be positive, got " << frame_rate_hz);
+  JVL_CHECK(max_accel > 0 && max_decel > 0, "acceleration limits must be positive");
+  JVL_CHECK(stop_duration >= 0, "stop duration must be >= 0");
+}
+
+Drive PlanDrive(const Route& route, const DriveOptions& options) {
+  options.Check();
+  Drive d;
+  const auto& pieces = route.pieces();
+  // Speed allowed at s: the piece's speed, and no faster than what still allows braking to the
+  // speed of every later piece (and to 0 at a stop).
+  auto allowed = [&](double s) {
+    double v = 1e9;
+    for (const RoadPiece& p : pieces) {
+      const double dist = std::max(0.0, p.s0 - s);
+      if (p.s0 + p.length < s) continue;
+      v = std::min(v, std::sqrt(p.speed * p.speed + 2 * options.max_decel * dist));
+    }
+    if (options.stop_at_s >= 0 && s <= options.stop_at_s) {
+      v = std::min(v, std::sqrt(2 * options.max_decel * (options.stop_at_s - s)));
+    }
+    return v;
+  };
+  double s = 0, v = std::min(pieces.front().speed, allowed(0.0)), stopped = 0;
+  bool stop_done = options.stop_at_s < 0;
+  d.s.push_back(s);
+  d.v.push_back(v);
+  while (s < route.length()) {
+    double a = (allowed(s) - v) / 0.5;
+    a = std::clamp(a, -options.max_decel * 1.5, options.max_accel);
+    if (!stop_done && options.stop_at_s - s < 0.2) {
+      a = 0;
+      v = 0;
+      stopped += d.dt;
+      if (stopped >= options.stop_duration) stop_done = true;
+    }
+    v = std::max(0.0, v + a * d.dt);
+    if (stop_done && v < 0.5) v = 0.5;  // Pull away after the stop.
+    s += v * d.dt;
+    d.s.push_back(std::min(s, route.length()));
+    d.v.push_back(v);
+    JVL_CHECK(d.s.size() < 10000000, "drive does not reach the end of the route");
+  }
+  return d;
+}
+
+double DriveArcLength(const Drive& drive, double t) {
+  const double x = std::clamp(t / drive.dt, 0.0, static_cast<double>(drive.s.size() - 1));
+  const size_t i = std::min(static_cast<size_t>(x), drive.s.size() - 2);
+  const double u = x - static_cast<double>(i);
+  return drive.s[i] + u * (drive.s[i + 1] - drive.s[i]);
+}
+
+Rigid3d VehiclePose(const Route& route, const Terrain& terrain, const Drive& drive,
+                    const DriveOptions& options, double t, uint64_t seed) {
+  const double s = DriveArcLength(drive, t);
+  const double x = std::clamp(t / drive.dt, 0.0, static_cast<double>(drive.v.size() - 1));
+  const double v = drive.v[static_cast<size_t>(x)];
+  const RoadPoint rp = route.At(s);
+  // Lane keeping: a slow weave around the lane centre; the heading follows its derivative.
+  const double phase = 6.283185307 * HashUnit(1, 2, seed);
+  const double w = 2 * kPi / 70.0;
+  const double lateral = options.lane_offset + options.lane_wobble * std::sin(w * s + phase);
+  const double dlat_ds = options.lane_wobble * w * std::cos(w * s + phase);
+  const Eigen::Vector2d normal(-std::sin(rp.heading), std::cos(rp.heading));
+  const Eigen::Vector2d p = rp.position + lateral * normal;
+  const double yaw = rp.heading + std::atan(dlat_ds);
+  // Pitch and roll from the terrain slope under the car; body roll leans out of turns
+  // (~0.5 deg per m/s^2 of lateral acceleration) plus a small suspension sway.
+  const Eigen::Vector2d g = terrain.Gradient(p.x(), p.y());
+  const Eigen::Vector2d fwd(std::cos(yaw), std::sin(yaw)), left(-std::sin(yaw), std::cos(yaw));
+  const double pitch = -std::atan(g.dot(fwd));
+  const double lat_acc = v * v * rp.curvature;
+  const double roll =
+      std::atan(g.dot(left)) + 0.0087 * lat_acc + 0.003 * std::sin(2 * kPi * s / 23.0 + 2 * phase);
+  const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
+  return Rigid3d(q, Eigen::Vector3d(p.x(), p.y(), terrain.Height(p.x(), p.y())));
+}
+
+}  // namespace jvl::sim

@@ -1,0 +1,102 @@
+// The road the vehicle drives: a chain of straight and circular-arc pieces on a gently rolling
+// terrain, and the vehicle motion along it (speed profile, lane keeping, pitch and roll).
+// Map frame: x east, y north, z up (metres). The vehicle base frame: x forward, y left, z up,
+// origin on the road surface below the LiDAR.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "geometry/rigid3.h"
+
+namespace jvl::sim {
+
+struct RoadPiece {
+  double length = 0;     // Arc length (m).
+  double curvature = 0;  // 1/radius, positive = left turn; 0 for a straight.
+  double speed = 10;     // Target speed on this piece (m/s).
+  bool open = false;     // No buildings along it (open road).
+  // Filled by Route: start pose and arc-length offset.
+  Eigen::Vector2d start = Eigen::Vector2d::Zero();
+  double start_heading = 0;
+  double s0 = 0;
+  bool IsStraight() const { return curvature == 0; }
+};
+
+struct RoadPoint {
+  Eigen::Vector2d position;
+  double heading = 0;  // Radians from +x, counter-clockwise.
+  double curvature = 0;
+  int piece = 0;
+};
+
+class Route {
+ public:
+  Route() = default;
+  // Chains the pieces starting at `start` with `heading`.
+  Route(std::vector<RoadPiece> pieces, const Eigen::Vector2d& start, double heading);
+
+  const std::vector<RoadPiece>& pieces() const { return pieces_; }
+  double length() const { return length_; }
+  // Centre line at arc length s (clamped to [0, length]).
+  RoadPoint At(double s) const;
+  // Nearest centre-line point over all pieces (exact projection onto lines and circles):
+  // arc length and signed lateral offset (left +).
+  void Project(const Eigen::Vector2d& p, double* s, double* lateral) const;
+  double Distance(const Eigen::Vector2d& p) const;
+
+ private:
+  // Per-piece constants for Project(): unit start direction, circle centre and radius (arcs),
+  // end point and heading, and a bounding circle (mid point, radius length/2).
+  struct Cache {
+    Eigen::Vector2d dir, centre, end, mid;
+    double radius = 0, end_heading = 0;
+  };
+  std::vector<RoadPiece> pieces_;
+  std::vector<Cache> cache_;
+  double length_ = 0;
+};
+
+// Rolling terrain: a sum of long-wavelength sinusoids (slopes of a few percent).
+struct Terrain {
+  double amplitude[3] = {1.6, 1.2, 0.4};
+  double wavelength[3] = {420.0, 330.0, 190.0};
+  double phase[3] = {0.3, 1.1, 2.0};
+  double Height(double x, double y) const;
+  Eigen::Vector2d Gradient(double x, double y) const;
+};
+
+// Scenario presets: route pieces, speeds and density of the world.
+enum class Scenario { kUrban, kSuburban, kHighway };
+Scenario ParseScenario(const std::string& name);  // urban|suburban|highway
+std::string ToString(Scenario scenario);
+std::vector<RoadPiece> ScenarioRoute(Scenario scenario);
+
+struct DriveOptions {
+  double frame_rate_hz = 10.0;
+  double max_accel = 1.2;      // m/s^2
+  double max_decel = 1.8;      // m/s^2
+  double lane_offset = -1.75;  // Right-hand traffic: centre of the right lane.
+  double lane_wobble = 0.12;   // Amplitude (m) of lane-keeping weaving.
+  double stop_at_s = -1;       // Arc length of a stop (< 0: no stop).
+  double stop_duration = 3.0;  // s
+  void Check() const;
+};
+
+// Vehicle motion: arc length and speed sampled at 100 Hz from t = 0 until the route ends.
+struct Drive {
+  double dt = 0.01;
+  std::vector<double> s, v;
+  double duration() const { return dt * static_cast<double>(s.size() - 1); }
+};
+Drive PlanDrive(const Route& route, const DriveOptions& options);
+
+// world_from_base of the vehicle at time t (interpolated), with pitch and roll from the terrain,
+// body roll from lateral acceleration and lane-keeping weaving. `seed` varies the weaving phase.
+Rigid3d VehiclePose(const Route& route, const Terrain& terrain, const Drive& drive,
+                    const DriveOptions& options, double t, uint64_t seed);
+// Arc length along the route at time t.
+double DriveArcLength(const Drive& drive, double t);
+
+}  // namespace jvl::sim

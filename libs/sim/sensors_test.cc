@@ -1,0 +1,236 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sim/scene_mesh.h"
+#include "sim/sequence.h"
+#include "sim/shading.h"
+
+namespace jvl::sim {
+namespace {
+
+std::unique_ptr<World> SmallWorld(double range_noise, double dropout) {
+  SequenceOptions opt;
+  opt.frames = 30;
+  opt.seed = 7;
+  opt.lidar.range_noise = range_noise;
+  opt.lidar.dropout = dropout;
+  return BuildWorld(opt);
+}
+
+// Every return lies on a scene surface: re-casting the ray towards the point finds a surface
+// at the measured range, within the range noise.
+TEST(LidarTest, ReturnsLieOnSurfacesWithinNoise) {
+  for (double sigma : {0.0, 0.02}) {
+    const auto world = SmallWorld(sigma, 0.0);
+    const SimFrame f = SimulateFrame(*world, 12);
+    ASSERT_GT(f.scan.size(), 60000u);
+    const Rigid3d map_from_velo = world->MapFromVeloAt(f.time);
+    std::vector<Box> moving;
+    for (size_t i = 0; i < world->scene.moving_cars.size(); ++i) {
+      moving.push_back(world->scene.MovingCarBox(i, f.time));
+    }
+    double sum2 = 0, max_err = 0;
+    int n = 0, far = 0;
+    for (size_t i = 0; i < f.scan.size(); i += 7) {
+      const Eigen::Vector3d p = f.scan.points[i];
+      const Eigen::Vector3d d = map_from_velo.RotationMatrix() * p.normalized();
+      Hit hit = world->caster->Intersect(map_from_velo.translation(), d, 0.05, 130);
+      IntersectBoxes(moving, map_from_velo.translation(), d, &hit);
+      ASSERT_TRUE(hit.valid());
+      const double e = p.norm() - hit.t;
+      sum2 += e * e;
+      max_err = std::max(max_err, std::abs(e));
+      far += std::abs(e) > 5 * sigma + 2e-3 ? 1 : 0;
+      ++n;
+    }
+    const double rms = std::sqrt(sum2 / n);
+    if (sigma == 0) {
+      EXPECT_LT(max_err, 2e-3);
+    } else {
+      EXPECT_NEAR(rms, sigma, 0.2 * sigma);
+      EXPECT_LT(far, n / 1000 + 1);
+    }
+  }
+}
+
+TEST(LidarTest, BeamPatternIsHdl64Like) {
+  const LidarOptions opt;
+  const auto e = opt.ElevationsRad();
+  ASSERT_EQ(e.size(), 64u);
+  EXPECT_NEAR(e.front() * 180 / M_PI, 2.0, 1e-9);
+  EXPECT_NEAR(e.back() * 180 / M_PI, -24.9, 1e-9);
+  for (size_t i = 1; i < e.size(); ++i) EXPECT_LT(e[i], e[i - 1]);
+  // Ground returns: the sensor is 1.73 m above the road (velodyne z ~ -1.73 close by).
+  const auto world = SmallWorld(0.0, 0.0);
+  const SimFrame f = SimulateFrame(*world, 0);
+  int ground = 0;
+  for (const auto& p : f.scan.points) {
+    if (p.head<2>().norm() < 6 && std::abs(p.y()) < 2) {
+      EXPECT_NEAR(p.z(), -1.73, 0.12);
+      ++ground;
+    }
+  }
+  EXPECT_GT(ground, 100);
+}
+
+// A dark square on an empty (sky) background appears centred on the projection of its centre.
+TEST(RenderTest, KnownPointProjectsToTheRightPixel) {
+  const PinholeCamera cam = KittiCalibration().Camera(0);
+  const Rigid3d world_from_cam(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())) *
+          Eigen::Quaterniond(Eigen::AngleAxisd(-0.05, Eigen::Vector3d::UnitX())),
+      Eigen::Vector3d(5, -1, 2));
+  for (const Eigen::Vector2d& target :
+       {Eigen::Vector2d(900.3, 250.7), Eigen::Vector2d(201.6, 80.2)}) {
+    const Eigen::Vector3d x_cam = 12.0 * cam.Unproject(target);
+    Scene scene;
+    // A thin 0.3 m plate facing the camera, centred on x_cam and axis-aligned in the camera
+    // frame: built in the camera frame, then moved to the world.
+    Mesh local;
+    AddBox(local, Eigen::Vector2d(x_cam.x(), x_cam.z() + 0.001), 0.0, 0.3, 0.002, -0.15, 0.15, 0.0,
+           Material::kCar, Material::kCar, -1, 0.0f);
+    // Boxes are built with z up; rotate (x, y, z) -> (x, z + y_cam, y) into the camera frame.
+    for (const auto& v : local.vertices) {
+      const Eigen::Vector3d pc(v.x(), v.z() + x_cam.y(), v.y());
+      scene.mesh.AddVertex(world_from_cam * pc);
+    }
+    scene.mesh.triangles = local.triangles;
+    scene.mesh.triangle_face = local.triangle_face;
+    scene.mesh.faces = local.faces;
+    const RayCaster caster(scene.mesh);
+    CameraOptions opt;
+    opt.pixel_noise = 0;
+    opt.blur_sigma = 0;
+    const cv::Mat img = RenderImage(scene, caster, cam, world_from_cam, {}, 1.0, 1, opt);
+    double su = 0, sv = 0, n = 0;
+    for (int v = 0; v < img.rows; ++v) {
+      for (int u = 0; u < img.cols; ++u) {
+        if (img.at<uint8_t>(v, u) < 100) su += u, sv += v, n += 1;
+      }
+    }
+    ASSERT_GT(n, 100);
+    EXPECT_NEAR(su / n, target.x(), 0.3);
+    EXPECT_NEAR(sv / n, target.y(), 0.3);
+  }
+}
+
+TEST(RenderTest, FeaturesLandOnStructure) {
+  const auto world = SmallWorld(0.02, 0.02);
+  const SimFrame f = SimulateFrame(*world, 10);
+  ASSERT_EQ(f.image.cols, 1226);
+  ASSERT_EQ(f.image.rows, 370);
+  const PinholeCamera cam = world->options.calibration.Camera(0);
+  const Rigid3d map_from_cam =
+      world->MapFromVeloAt(f.time) * world->options.calibration.cam0_from_velo.Inverse();
+  // What does the ray through pixel (u, v) hit?  0 window/facade, 1 marking, 2 other, 3 sky.
+  auto label = [&](double u, double v) {
+    const Eigen::Vector3d d = (map_from_cam.RotationMatrix() * cam.Unproject({u, v})).normalized();
+    const Hit hit = world->caster->Intersect(map_from_cam.translation(), d, 0.05, 400);
+    if (!hit.valid()) return 3;
+    const Surface s = ShadeSurface(world->scene, hit, map_from_cam.translation() + hit.t * d);
+    if (s.marking) return 1;
+    if (hit.face >= 0 && world->scene.mesh.faces[hit.face].material == Material::kFacade) return 0;
+    return 2;
+  };
+  std::vector<cv::KeyPoint> kps;
+  cv::ORB::create(1000)->detect(f.image, kps);
+  int counts[4] = {0, 0, 0, 0};
+  for (const auto& kp : kps) ++counts[label(kp.pt.x, kp.pt.y)];
+  ASSERT_GT(kps.size(), 500u);
+  EXPECT_GT(counts[0] + counts[1], static_cast<int>(kps.size()) / 2)
+      << "facade " << counts[0] << " marking " << counts[1] << " other " << counts[2];
+  auto lsd = cv::createLineSegmentDetector();
+  std::vector<cv::Vec4f> lines;
+  lsd->detect(f.image, lines);
+  int long_lines = 0, on_facade = 0;
+  for (const auto& l : lines) {
+    if (std::hypot(l[2] - l[0], l[3] - l[1]) < 30) continue;
+    ++long_lines;
+    on_facade += label((l[0] + l[2]) / 2, (l[1] + l[3]) / 2) == 0 ? 1 : 0;
+  }
+  std::printf(
+      "frame 10: ORB %zu keypoints: facade %d, lane marking %d, other %d, sky %d; "
+      "LSD %d segments >= 30 px, %d on facades\n",
+      kps.size(), counts[0], counts[1], counts[2], counts[3], long_lines, on_facade);
+  EXPECT_GT(long_lines, 50);
+  EXPECT_GT(on_facade, long_lines / 3);
+}
+
+// The road VP agrees with the GT pose and with the meeting point of the lane edge lines.
+TEST(GroundTruthTest, RoadVpIsTheProjectionOfTheRoadDirection) {
+  const auto world = SmallWorld(0.02, 0.02);
+  const PinholeCamera cam = world->options.calibration.Camera(0);
+  for (int64_t k : {3, 17, 29}) {
+    const double t = world->ground_truth.timestamps[k];
+    const SimFrame f = SimulateFrame(*world, k);
+    ASSERT_FALSE(f.vps.empty());
+    const GtVanishingPoint& road = f.vps.front();
+    ASSERT_EQ(road.kind, VpKind::kRoad);
+    ASSERT_TRUE(road.in_image);
+    // Independent route: the GT pose (world frame) and a far point along the road direction.
+    const Rigid3d map_from_cam = world->map_from_world * world->ground_truth.world_from_cam[k];
+    const double s = DriveArcLength(world->drive, t);
+    const RoadPoint rp = world->scene.route.At(s);
+    const Eigen::Vector2d tan(std::cos(rp.heading), std::sin(rp.heading));
+    const double slope = world->scene.terrain.Gradient(rp.position.x(), rp.position.y()).dot(tan);
+    const Eigen::Vector3d far = Eigen::Vector3d(rp.position.x(), rp.position.y(), 0) +
+                                1e7 * Eigen::Vector3d(tan.x(), tan.y(), slope);
+    const Eigen::Vector2d uv = cam.Project(map_from_cam.Inverse() * far);
+    EXPECT_LT((uv - road.uv).norm(), 0.5) << "frame " << k;
+    // Lane edge lines (+-3.5 m) between 25 and 45 m ahead meet near the VP (the terrain bends
+    // them slightly).
+    auto edge = [&](double lat, double ahead) {
+      const RoadPoint q = world->scene.route.At(s + ahead);
+      const Eigen::Vector2d p =
+          q.position + lat * Eigen::Vector2d(-std::sin(q.heading), std::cos(q.heading));
+      const Eigen::Vector3d x(p.x(), p.y(), world->scene.terrain.Height(p.x(), p.y()));
+      const Eigen::Vector2d pix = cam.Project(map_from_cam.Inverse() * x);
+      return Eigen::Vector3d(pix.x(), pix.y(), 1.0);
+    };
+    const Eigen::Vector3d l1 = edge(3.5, 25).cross(edge(3.5, 45));
+    const Eigen::Vector3d l2 = edge(-3.5, 25).cross(edge(-3.5, 45));
+    const Eigen::Vector3d x = l1.cross(l2);
+    EXPECT_LT((x.head<2>() / x.z() - road.uv).norm(), 12.0) << "frame " << k;
+  }
+}
+
+}  // namespace
+}  // namespace jvl::sim
+
+namespace jvl::sim {
+namespace {
+
+// Moving forward at 10 m/s towards a wall 20 m ahead: without distortion the wall is at x = 20
+// in every column; with it, a column fired tau seconds from the frame time measures 20 - 10 tau
+// (tau = -0.1 az / 2 pi: the sweep runs clockwise and passes forward at the frame time).
+TEST(LidarTest, MotionDistortionShiftsColumnsByTheMotion) {
+  Scene scene;
+  AddBox(scene.mesh, Eigen::Vector2d(20.5, 0), 0.0, 1.0, 100.0, -50, 50, 0, Material::kFacade,
+         Material::kRoof, -1, 0.5f);
+  for (auto& f : scene.mesh.faces) f.material = Material::kPole;  // Plain, no windows.
+  const RayCaster caster(scene.mesh);
+  LidarOptions opt;
+  opt.range_noise = 0;
+  opt.dropout = 0;
+  const SweepPose sweep = [](double tau) {
+    return Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(10 * tau, 0, 0));
+  };
+  for (bool distort : {false, true}) {
+    opt.motion_distortion = distort;
+    const PointCloud scan = SimulateScan(scene, caster, Rigid3d(), {}, opt, 1, &sweep);
+    ASSERT_GT(scan.size(), 1000u);
+    for (const auto& p : scan.points) {
+      const double az = std::atan2(p.y(), p.x());
+      const double expected = distort ? 20.0 + az / (2 * M_PI) : 20.0;
+      EXPECT_NEAR(p.x(), expected, 2e-3) << "az " << az;
+      if (std::abs(p.x() - expected) > 2e-3) break;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace jvl::sim

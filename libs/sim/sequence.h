@@ -1,0 +1,72 @@
+// A complete synthetic sequence: route, scene, drive and sensor rig, and the per-frame sensor
+// data (LiDAR scan, camera image) plus ground truth (poses, vanishing points).
+//
+// Frames: the world frame of the poses is cam0 of frame 0 (as KITTI's poses/NN.txt); the scene
+// itself is built in a map frame (x east, y north, z up), related by World::map_from_world.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "geometry/calibration.h"
+#include "geometry/point_cloud.h"
+#include "geometry/trajectory.h"
+#include "sim/ground_truth.h"
+#include "sim/lidar.h"
+#include "sim/raycaster.h"
+#include "sim/render.h"
+#include "sim/road.h"
+#include "sim/scene.h"
+
+namespace jvl::sim {
+
+// KITTI odometry calibration of sequence 04 (calib.txt: P0..P3 and Tr), image 1226 x 370.
+Calibration KittiCalibration();
+
+struct SequenceOptions {
+  Scenario scenario = Scenario::kUrban;
+  uint64_t seed = 1;
+  int64_t frames = 0;          // 0: drive the whole route.
+  bool stop = false;           // Stop for a few seconds before the second corner.
+  double lidar_height = 1.73;  // Velodyne above the road (KITTI setup).
+  Calibration calibration = KittiCalibration();
+  DriveOptions drive;
+  SceneOptions scene;
+  LidarOptions lidar;
+  CameraOptions camera;
+  bool render_images = true;
+  bool simulate_scans = true;
+  void Check() const;
+};
+
+struct World {
+  SequenceOptions options;
+  Scene scene;
+  std::unique_ptr<RayCaster> caster;
+  Drive drive;
+  Rigid3d map_from_world;         // Map frame from the pose world frame (cam0 of frame 0).
+  Trajectory ground_truth;        // world_from_cam0 per frame, with timestamps.
+  Trajectory MapFromCam() const;  // The same poses in the map frame.
+  Rigid3d MapFromVeloAt(double t) const;
+};
+
+std::unique_ptr<World> BuildWorld(const SequenceOptions& options);
+
+struct SimFrame {
+  int64_t frame = 0;
+  double time = 0;
+  PointCloud scan;  // Velodyne frame; empty when scans are disabled.
+  cv::Mat image;    // CV_8U; empty when images are disabled.
+  std::vector<GtVanishingPoint> vps;
+};
+
+SimFrame SimulateFrame(const World& world, int64_t frame);
+
+// Simulates every frame on `threads` threads; sink(frame) is called from the worker threads
+// (each frame exactly once, in no particular order). Results depend only on the frame index.
+void GenerateSequence(const World& world, int threads, const std::function<void(SimFrame&&)>& sink);
+
+}  // namespace jvl::sim
