@@ -8,8 +8,8 @@ namespace {
 
 template <typename T>
 void CheckLength(const std::vector<T>& v, size_t n, const char* name, const std::string& where) {
-  JVL_CHECK(v.size() == n, where << ": diagnostics/" << name << " has " << v.size()
-                                 << " entries, expected " << n);
+  JVL_CHECK(v.size() == n,
+            where << ": diagnostics/" << name << " has " << v.size() << " entries, expected " << n);
 }
 
 void CheckDiagnostics(const OdometryDiagnostics& d, size_t n, const std::string& where) {

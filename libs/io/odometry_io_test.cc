@@ -18,9 +18,9 @@ namespace fs = std::filesystem;
 OdometryArtifact MakeArtifact(int n) {
   OdometryArtifact a;
   for (int i = 0; i < n; ++i) {
-    a.trajectory.Append(10 + i, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.01 * i, 0)),
-                                        Eigen::Vector3d(0.1, 0, 1.2 * i)),
-                        0.1 * i);
+    a.trajectory.Append(
+        10 + i, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.01 * i, 0)), Eigen::Vector3d(0.1, 0, 1.2 * i)),
+        0.1 * i);
     OdometryDiagnostics& d = a.diagnostics;
     d.iterations.push_back(i);
     d.residual.push_back(0.01 * i);

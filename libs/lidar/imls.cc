@@ -23,7 +23,7 @@ void ImlsModel::AddScan(int64_t scan_id, const std::vector<Eigen::Vector3d>& wor
     const uint64_t key = PackCell(c.x(), c.y(), c.z());
     std::vector<Entry>& cell = cells_[key];
     if (cell.empty() || cell.back().scan != scan_id) touched.push_back(key);
-    cell.push_back({world_points[i], world_normals[i], scan_id});
+    cell.push_back({world_points[i].cast<float>(), world_normals[i].cast<float>(), scan_id});
   }
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
@@ -32,8 +32,8 @@ void ImlsModel::AddScan(int64_t scan_id, const std::vector<Eigen::Vector3d>& wor
 }
 
 void ImlsModel::RemoveScan(int64_t scan_id) {
-  const auto it = std::find_if(scans_.begin(), scans_.end(),
-                               [&](const auto& s) { return s.first == scan_id; });
+  const auto it =
+      std::find_if(scans_.begin(), scans_.end(), [&](const auto& s) { return s.first == scan_id; });
   if (it == scans_.end()) return;
   for (const uint64_t key : it->second) {
     const auto cell = cells_.find(key);
@@ -74,7 +74,7 @@ bool ImlsModel::HasNeighbor(const Eigen::Vector3d& x, double radius) const {
         const auto it = cells_.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
         if (it == cells_.end()) continue;
         for (const Entry& e : it->second) {
-          if ((e.point - x).squaredNorm() <= r2) return true;
+          if ((e.point.cast<double>() - x).squaredNorm() <= r2) return true;
         }
       }
     }
@@ -101,7 +101,7 @@ bool ImlsModel::Project(const Eigen::Vector3d& x, double h, double radius,
         const auto it = cells_.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
         if (it == cells_.end()) continue;
         for (const Entry& e : it->second) {
-          const Eigen::Vector3d d = x - e.point;
+          const Eigen::Vector3d d = x - e.point.cast<double>();
           const double d2 = d.squaredNorm();
           if (d2 > r2) continue;
           const double w = std::exp(-d2 * inv_h2);
@@ -117,15 +117,15 @@ bool ImlsModel::Project(const Eigen::Vector3d& x, double h, double radius,
     }
   }
   if (nearest == nullptr) return false;
-  out->normal = nearest->normal;
-  out->nearest = nearest->point;
+  out->normal = nearest->normal.cast<double>().normalized();
+  out->nearest = nearest->point.cast<double>();
   out->nearest_scan = nearest->scan;
   out->neighbors = count;
   // Far from every point relative to h all weights underflow: the nearest point alone
   // defines the surface (the limit of Eq. 2 as h -> 0).
-  const Eigen::Vector3d mean_d =
-      sum_w > std::numeric_limits<double>::min() ? Eigen::Vector3d(sum_wd / sum_w)
-                                                 : Eigen::Vector3d(x - nearest->point);
+  const Eigen::Vector3d mean_d = sum_w > std::numeric_limits<double>::min()
+                                     ? Eigen::Vector3d(sum_wd / sum_w)
+                                     : Eigen::Vector3d(x - out->nearest);
   out->distance = mean_d.dot(out->normal);
   out->projection = x - out->distance * out->normal;
   return true;

@@ -54,8 +54,10 @@ class ImlsModel {
 
  private:
   int Span(double radius) const;  // Cells to visit on each side.
+  // Single precision halves the memory streamed by Project (the hot loop); at 2 km from the
+  // world origin a float still resolves 0.12 mm.
   struct Entry {
-    Eigen::Vector3d point, normal;
+    Eigen::Vector3f point, normal;
     int64_t scan;
   };
   double cell_size_, inv_cell_;

@@ -68,7 +68,7 @@ TEST(ImlsTest, ScansAddedAndRemoved) {
   EXPECT_EQ(model.size(), 1u);
   ImlsProjection p;
   ASSERT_TRUE(model.Project(Eigen::Vector3d(0, 0, 0.5), 0.1, 1.0, &p));
-  EXPECT_NEAR(p.distance, 0.3, 1e-12);
+  EXPECT_NEAR(p.distance, 0.3, 1e-6);  // Model stored in single precision.
   EXPECT_EQ(p.nearest_scan, 2);
   model.RemoveScan(42);  // Absent: no-op.
   model.RemoveScan(2);
@@ -88,7 +88,7 @@ TEST(SurfaceTest, NormalsAndPlanarityOfAPlaneAndALine) {
   for (size_t i = 0; i < n_plane; ++i) {
     ASSERT_TRUE(s.valid[i]);
     EXPECT_NEAR(s.normals[i].y(), -1.0, 1e-9);  // Towards the sensor (up is -y).
-    EXPECT_GT(s.planarity[i], 0.5);  // 1 inside the patch, lower at its border.
+    EXPECT_GT(s.planarity[i], 0.5);             // 1 inside the patch, lower at its border.
   }
   for (size_t i = n_plane; i < pts.size(); ++i) {
     if (s.valid[i]) {

@@ -14,6 +14,15 @@ namespace {
 // sorted; sampling stops at s accepted points).
 constexpr size_t kListLengthFactor = 20;
 
+// Constant velocity within the scan: a point taken at fraction s of the period was seen from
+// cur_from_sensor(s) = Exp(s Log(prev_from_cur)).
+void Deskew(const Rigid3d& prev_from_cur, PreprocessedScan* scan) {
+  const Vector6d xi = LogSE3(prev_from_cur);
+  for (size_t i = 0; i < scan->points.size(); ++i) {
+    scan->points[i] = ExpSE3(static_cast<double>(scan->time_fraction[i]) * xi) * scan->points[i];
+  }
+}
+
 }  // namespace
 
 void OdometryOptions::Check() const {
@@ -56,19 +65,48 @@ Rigid3d Odometry::PredictMotion() const {
 }
 
 RegistrationResult Odometry::Register(const ScanSurface& surface, const Rigid3d& predicted,
-                                      const RegistrationOptions& options, int* samples) const {
+                                      const RegistrationOptions& options, int per_list,
+                                      int* samples) const {
   // IMLS-SLAM sampling: s points per list with a model neighbour within r at the prediction.
-  const auto lists =
-      SamplingLists(surface, kListLengthFactor * static_cast<size_t>(options_.samples_per_list));
+  const auto lists = SamplingLists(surface, kListLengthFactor * static_cast<size_t>(per_list));
   const double r = options.search_radius;
-  const std::vector<int> picked =
-      SelectSamples(lists, surface.size(), options_.samples_per_list,
-                    [&](int i) { return model_.HasNeighbor(predicted * surface.points[i], r); });
+  const std::vector<int> picked = SelectSamples(lists, surface.size(), per_list, [&](int i) {
+    return model_.HasNeighbor(predicted * surface.points[i], r);
+  });
   std::vector<Eigen::Vector3d> points;
+  std::vector<double> planarity;
   points.reserve(picked.size());
-  for (const int i : picked) points.push_back(surface.points[i]);
+  for (const int i : picked) {
+    points.push_back(surface.points[i]);
+    planarity.push_back(surface.planarity[i]);
+  }
   *samples = static_cast<int>(points.size());
-  return RegisterScan(points, model_, predicted, options, threads_);
+  return RegisterScan(points, model_, predicted, options, threads_, &planarity);
+}
+
+RegistrationResult Odometry::Track(const ScanSurface& surface, const Rigid3d& predicted,
+                                   int* samples) const {
+  const int s = options_.samples_per_list;
+  Rigid3d start = predicted;
+  if (frames_.size() == 1 && options_.initial_search_scale > 1) {
+    // No velocity yet: a coarse registration with wider neighbourhoods seeds the normal one,
+    // on a quarter of the samples (the wide neighbourhoods make each query ~20x dearer).
+    RegistrationOptions coarse = options_.registration;
+    const double k = options_.initial_search_scale;
+    coarse.search_radius *= k;
+    coarse.kernel_h *= k;
+    coarse.max_distance *= k;
+    coarse.robust_scale *= k;
+    const RegistrationResult first =
+        Register(surface, predicted, coarse, std::max(1, s / 4), samples);
+    if (first.ok) start = first.world_from_scan;
+  }
+  RegistrationResult reg = Register(surface, start, options_.registration, s, samples);
+  if (reg.degenerate && start.translation() != predicted.translation()) {
+    // Along unobservable directions the motion model, not the coarse pass, must be kept.
+    reg = Register(surface, predicted, options_.registration, s, samples);
+  }
+  return reg;
 }
 
 void Odometry::UpdateModel(int64_t frame, const ScanSurface& surface,
@@ -103,14 +141,7 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
   d.points_after_filter = static_cast<int64_t>(pre.points.size());
   d.preprocess_ms = timer.ElapsedMs();
   const Rigid3d motion = PredictMotion();
-  if (options_.deskew && frames_.size() >= 2) {
-    // Constant velocity within the scan: a point taken at fraction s of the period was seen
-    // from cur_from_sensor(s) = Exp(s Log(prev_from_cur)).
-    const Vector6d xi = LogSE3(motion);
-    for (size_t i = 0; i < pre.points.size(); ++i) {
-      pre.points[i] = ExpSE3(static_cast<double>(pre.time_fraction[i]) * xi) * pre.points[i];
-    }
-  }
+  if (options_.deskew && frames_.size() >= 2) Deskew(motion, &pre);
   const ScanSurface surface = ComputeSurface(pre.points, options_.surface, threads_);
   d.surface_ms = timer.ElapsedMs() - d.preprocess_ms;
 
@@ -118,24 +149,8 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
     d.status = FrameStatus::kFirstFrame;
     out.world_from_cam = Rigid3d();
   } else {
-    const Rigid3d predicted = frames_.back().world_from_cam * motion;
-    Rigid3d start = predicted;
-    if (frames_.size() == 1 && options_.initial_search_scale > 1) {
-      // No velocity yet: a coarse registration with wider neighbourhoods seeds the normal one.
-      RegistrationOptions coarse = options_.registration;
-      const double k = options_.initial_search_scale;
-      coarse.search_radius *= k;
-      coarse.kernel_h *= k;
-      coarse.max_distance *= k;
-      coarse.robust_scale *= k;
-      const RegistrationResult first = Register(surface, predicted, coarse, &d.samples);
-      if (first.ok) start = first.world_from_scan;
-    }
-    RegistrationResult reg = Register(surface, start, options_.registration, &d.samples);
-    if (reg.degenerate && start.translation() != predicted.translation()) {
-      // Along unobservable directions the motion model, not the coarse pass, must be kept.
-      reg = Register(surface, predicted, options_.registration, &d.samples);
-    }
+    const RegistrationResult reg =
+        Track(surface, frames_.back().world_from_cam * motion, &d.samples);
     out.world_from_cam = reg.world_from_scan;
     d.iterations = reg.iterations;
     d.residual = reg.residual;
@@ -145,15 +160,17 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
     if (!reg.ok) {
       d.status = FrameStatus::kMotionModel;
       d.degenerate = true;
-      spdlog::warn("frame {}: {} points after filtering, {} correspondences: using the "
-                   "constant-velocity motion model",
-                   frame, d.points_after_filter, reg.correspondences);
+      spdlog::warn(
+          "frame {}: {} points after filtering, {} correspondences: using the "
+          "constant-velocity motion model",
+          frame, d.points_after_filter, reg.correspondences);
     } else if (reg.degenerate) {
       d.status = FrameStatus::kDegenerate;
       d.degenerate = true;
-      spdlog::warn("frame {}: degenerate geometry ({} unobservable directions, min eigenvalue "
-                   "{:.2e}): motion model kept along them",
-                   frame, reg.degenerate_directions, reg.min_eigenvalue);
+      spdlog::warn(
+          "frame {}: degenerate geometry ({} unobservable directions, min eigenvalue "
+          "{:.2e}): motion model kept along them",
+          frame, reg.degenerate_directions, reg.min_eigenvalue);
     }
   }
   d.register_ms = timer.ElapsedMs() - d.preprocess_ms - d.surface_ms;

@@ -25,9 +25,9 @@ struct OdometryOptions {
   PreprocessOptions preprocess;
   SurfaceOptions surface;
   RegistrationOptions registration;
-  int scan_map_size = 10;       // N: scans kept in the model.
-  int samples_per_list = 100;   // s of IMLS-SLAM (9 lists -> up to 900 points).
-  bool deskew = false;          // Constant-velocity de-skewing from the point azimuths.
+  int scan_map_size = 10;      // N: scans kept in the model.
+  int samples_per_list = 100;  // s of IMLS-SLAM (9 lists -> up to 900 points).
+  bool deskew = false;         // Constant-velocity de-skewing from the point azimuths.
   // Second scan (no motion estimate yet): a coarse registration first runs with the search
   // radius, kernel h, max distance and robust scale multiplied by this (1 = off).
   double initial_search_scale = 4.0;
@@ -37,20 +37,20 @@ struct OdometryOptions {
 // How a frame's pose was obtained (stored per frame in the artifact).
 enum class FrameStatus : int32_t {
   kOk = 0,
-  kFirstFrame = 1,    // Defines the world frame (identity).
-  kDegenerate = 2,    // Registered; unobservable directions kept from the motion model.
-  kMotionModel = 3,   // Too few points or correspondences: constant-velocity pose.
+  kFirstFrame = 1,   // Defines the world frame (identity).
+  kDegenerate = 2,   // Registered; unobservable directions kept from the motion model.
+  kMotionModel = 3,  // Too few points or correspondences: constant-velocity pose.
 };
 const char* ToString(FrameStatus status);
 
 struct FrameDiagnostics {
   FrameStatus status = FrameStatus::kOk;
   int iterations = 0;
-  double residual = 0;          // RMS IMLS distance at the last iteration (m).
+  double residual = 0;  // RMS IMLS distance at the last iteration (m).
   int correspondences = 0;
-  double time_ms = 0;           // Whole ProcessScan.
+  double time_ms = 0;                                         // Whole ProcessScan.
   double preprocess_ms = 0, surface_ms = 0, register_ms = 0;  // Its main stages.
-  bool degenerate = false;      // Any fallback to the motion model (partial or full).
+  bool degenerate = false;  // Any fallback to the motion model (partial or full).
   bool converged = false;
   int64_t points_after_filter = 0;
   int64_t non_finite_points = 0;  // Dropped NaN/inf points of the input scan.
@@ -78,8 +78,11 @@ class Odometry {
 
  private:
   Rigid3d PredictMotion() const;  // prev_from_cur of the constant-velocity model.
+  // Registration from the prediction, with the coarse pass of the second scan.
+  RegistrationResult Track(const ScanSurface& surface, const Rigid3d& predicted,
+                           int* samples) const;
   RegistrationResult Register(const ScanSurface& surface, const Rigid3d& predicted,
-                              const RegistrationOptions& options, int* samples) const;
+                              const RegistrationOptions& options, int per_list, int* samples) const;
   void UpdateModel(int64_t frame, const ScanSurface& surface, const Rigid3d& world_from_cam);
 
   Rigid3d cam0_from_velo_;

@@ -66,9 +66,9 @@ TEST(OdometryTest, EmptyScanAfterFilteringFallsBackToMotionModel) {
   EXPECT_TRUE(f.diagnostics.degenerate);
   EXPECT_EQ(f.diagnostics.points_after_filter, 0);
   // Constant velocity: frame 2 continues the motion from frame 0 to 1.
-  const Rigid3d expected = odometry.frames()[1].world_from_cam *
-                           (odometry.frames()[0].world_from_cam.Inverse() *
-                            odometry.frames()[1].world_from_cam);
+  const Rigid3d expected =
+      odometry.frames()[1].world_from_cam *
+      (odometry.frames()[0].world_from_cam.Inverse() * odometry.frames()[1].world_from_cam);
   EXPECT_LT((f.world_from_cam.translation() - expected.translation()).norm(), 1e-9);
   // An entirely empty scan, also as the very first one, does not throw either.
   Odometry fresh(Rigid3d(), OdometryOptions(), 1);

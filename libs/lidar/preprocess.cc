@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 #include "core/check.h"
 #include "lidar/voxel_grid.h"
@@ -54,9 +53,9 @@ void PreprocessOptions::Check() const {
   JVL_CHECK(min_range >= 0, "--min-range must be >= 0, got " << min_range);
   JVL_CHECK(max_range == 0 || max_range > min_range,
             "--max-range must be 0 or > --min-range, got " << max_range);
-  JVL_CHECK(std::abs(vertical_correction_deg) < 5,
-            "--vertical-correction must be a small angle in degrees, got "
-                << vertical_correction_deg);
+  JVL_CHECK(
+      std::abs(vertical_correction_deg) < 5,
+      "--vertical-correction must be a small angle in degrees, got " << vertical_correction_deg);
   JVL_CHECK(voxel_size >= 0, "--voxel-size must be >= 0, got " << voxel_size);
   JVL_CHECK(outlier_radius >= 0, "--outlier-radius must be >= 0, got " << outlier_radius);
   JVL_CHECK(outlier_method == "grid" || outlier_method == "pcl",
@@ -90,8 +89,7 @@ float AzimuthTimeFraction(const Eigen::Vector3d& velo_point) {
 }
 
 std::vector<uint8_t> RadiusOutlierMask(const std::vector<Eigen::Vector3d>& points, double radius,
-                                       int min_neighbors, const std::string& method,
-                                       int threads) {
+                                       int min_neighbors, const std::string& method, int threads) {
   std::vector<uint8_t> keep(points.size(), 1);
   if (points.empty() || radius <= 0 || min_neighbors <= 0) return keep;
   if (method == "grid") {
@@ -165,15 +163,15 @@ std::vector<uint8_t> SmallObjectMask(const std::vector<Eigen::Vector3d>& points,
   *clusters_removed = 0;
   // Cells of non-ground points, numbered in first-seen order (deterministic).
   const double inv = 1.0 / options.cluster_cell;
-  std::unordered_map<uint64_t, int, CellHash> cell_id;
+  CellMap cell_id(points.size() / 4);
   std::vector<Eigen::Vector3i> cells;
   std::vector<int> point_cell(points.size(), -1);
   for (size_t i = 0; i < points.size(); ++i) {
     if (is_ground[i]) continue;
     const Eigen::Vector3i c = CellOf(points[i], inv);
-    const auto it = cell_id.emplace(PackCell(c.x(), c.y(), c.z()), static_cast<int>(cells.size()));
-    if (it.second) cells.push_back(c);
-    point_cell[i] = it.first->second;
+    const int id = cell_id.Insert(PackCell(c.x(), c.y(), c.z()), static_cast<int>(cells.size()));
+    if (id == static_cast<int>(cells.size())) cells.push_back(c);
+    point_cell[i] = id;
   }
   // Connected components over the 26-neighbourhood of occupied cells.
   std::vector<int> parent(cells.size());
@@ -185,9 +183,9 @@ std::vector<uint8_t> SmallObjectMask(const std::vector<Eigen::Vector3d>& points,
       for (int dy = (dx == 0 ? 0 : -1); dy <= 1; ++dy) {
         for (int dz = (dx == 0 && dy == 0 ? 1 : -1); dz <= 1; ++dz) {
           const Eigen::Vector3i& c = cells[a];
-          const auto it = cell_id.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
-          if (it == cell_id.end()) continue;
-          const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, it->second);
+          const int b = cell_id.Find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
+          if (b < 0) continue;
+          const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, b);
           if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
         }
       }

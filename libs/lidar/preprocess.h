@@ -19,13 +19,13 @@
 namespace jvl::lidar {
 
 struct PreprocessOptions {
-  double min_range = 5.0;    // m, supplement 1.1.
-  double max_range = 0.0;    // m, 0 = no limit.
+  double min_range = 5.0;  // m, supplement 1.1.
+  double max_range = 0.0;  // m, 0 = no limit.
   // KITTI HDL-64 intrinsic elevation error (degrees, e.g. 0.205); 0 = off.
   double vertical_correction_deg = 0.0;
   // Voxel downsampling (m) applied after the range cut; all later steps and the model use the
   // downsampled points. 0 = keep every point.
-  double voxel_size = 0.3;
+  double voxel_size = 0.4;
   // PCL RadiusOutlierRemoval: keep points with at least min_neighbors others within radius.
   double outlier_radius = 1.0;
   int outlier_min_neighbors = 2;
@@ -36,7 +36,7 @@ struct PreprocessOptions {
   double ground_distance = 0.25;
   double ground_max_angle_deg = 15.0;
   int ground_max_iterations = 100;
-  int ground_max_samples = 4000;  // RANSAC runs on an evenly strided subset of this size.
+  int ground_max_samples = 2000;  // RANSAC runs on an evenly strided subset of this size.
   // Small-object removal: clusters of non-ground points connected through cells of this size,
   // dropped when their bounding box is below all three extents (IMLS-SLAM: 14 x 14 x 4 m).
   bool remove_small_objects = true;

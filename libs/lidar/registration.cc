@@ -54,9 +54,11 @@ void RegistrationOptions::Check() const {
             "--degeneracy-threshold must be >= 0, got " << degeneracy_threshold);
 }
 
-RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
-                                const ImlsModel& model, const Rigid3d& initial,
-                                const RegistrationOptions& options, int threads) {
+RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, const ImlsModel& model,
+                                const Rigid3d& initial, const RegistrationOptions& options,
+                                int threads, const std::vector<double>* planarity) {
+  JVL_CHECK(planarity == nullptr || planarity->size() == points.size(),
+            "planarity has " << planarity->size() << " entries for " << points.size() << " points");
   RegistrationResult result;
   result.world_from_scan = initial;
   // Characteristic length that makes rotation columns comparable to translation ones.
@@ -64,15 +66,17 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
   for (const Eigen::Vector3d& p : points) range2 += p.squaredNorm();
   const double length = points.empty() ? 1.0 : std::max(1.0, std::sqrt(range2 / points.size()));
   Rigid3d t = initial;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> weak_directions;  // Of the last iteration.
   for (int it = 0; it < options.max_iterations; ++it) {
     const std::vector<Correspondence> corr = Associate(points, model, t, options, threads);
     // Normal equations of sum w (I + J d)^2 with J = [n, ((x - c) x n) / L] and the rotation
     // applied about the sensor position c (keeps translation and rotation decoupled).
-    Matrix6d h = Matrix6d::Zero();
+    Matrix6d h = Matrix6d::Zero(), h_obs = Matrix6d::Zero();
     Vector6d g = Vector6d::Zero();
-    double sum_w = 0, sum_r2 = 0;
+    double sum_w = 0, sum_obs = 0, sum_r2 = 0;
     int count = 0;
-    for (const Correspondence& c : corr) {  // Fixed order: deterministic sums.
+    for (size_t i = 0; i < corr.size(); ++i) {  // Fixed order: deterministic sums.
+      const Correspondence& c = corr[i];
       if (!c.valid) continue;
       Vector6d j;
       j.head<3>() = c.normal;
@@ -82,6 +86,10 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
       h += w * j * j.transpose();
       g += w * c.distance * j;
       sum_w += w;
+      // Observability counts planar evidence: corners and edges (low a2D) have biased normals.
+      const double a2 = planarity ? (*planarity)[i] * (*planarity)[i] : 1.0;
+      h_obs += w * a2 * j * j.transpose();
+      sum_obs += w * a2;
       sum_r2 += c.distance * c.distance;
       ++count;
     }
@@ -94,19 +102,25 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
       return result;
     }
     result.ok = true;
-    const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(h / sum_w);
-    result.min_eigenvalue = eig.eigenvalues()[0];
-    // Solve in the eigenbasis, dropping unobservable directions (they keep the initial guess).
-    Vector6d delta = Vector6d::Zero();
-    const Vector6d rhs = -eig.eigenvectors().transpose() * (g / sum_w);
+    // Unobservable directions: eigenvectors of the (planarity-weighted) normal matrix with a
+    // small eigenvalue. The update is solved in the complementary subspace.
+    const Eigen::SelfAdjointEigenSolver<Matrix6d> obs(h_obs / std::max(sum_obs, 1e-300));
+    result.min_eigenvalue = obs.eigenvalues()[0];
     int weak = 0;
+    weak_directions.resize(6, 0);
     for (int k = 0; k < 6; ++k) {
-      if (eig.eigenvalues()[k] < options.degeneracy_threshold) {
-        ++weak;
-        continue;
-      }
-      delta += (rhs[k] / eig.eigenvalues()[k]) * eig.eigenvectors().col(k);
+      if (obs.eigenvalues()[k] >= options.degeneracy_threshold) continue;
+      ++weak;
+      weak_directions.conservativeResize(6, weak);
+      weak_directions.col(weak - 1) = obs.eigenvectors().col(k);
     }
+    Matrix6d project = Matrix6d::Identity();
+    for (int k = 0; k < weak; ++k) {
+      project -= weak_directions.col(k) * weak_directions.col(k).transpose();
+    }
+    // Minimise over d = P z: (P H P + (I - P)) z = -P g keeps d in the observable subspace.
+    const Matrix6d a = project * (h / sum_w) * project + (Matrix6d::Identity() - project);
+    const Vector6d delta = project * a.ldlt().solve(-project * (g / sum_w));
     result.degenerate_directions = weak;
     result.degenerate = weak > 0;
     const Eigen::Vector3d v = delta.head<3>();
@@ -117,6 +131,19 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
       result.converged = true;
       break;
     }
+  }
+  if (result.degenerate) {
+    // Earlier iterations may have moved along a direction found unobservable at the end (the
+    // solution slides along a corridor): remove that component of the total change so the
+    // pose keeps the initial guess (motion model) along it.
+    Vector6d total;
+    total.head<3>() = t.translation() - initial.translation();
+    total.tail<3>() = LogSO3(t.rotation() * initial.rotation().inverse()) * length;
+    for (int k = 0; k < weak_directions.cols(); ++k) {
+      total -= weak_directions.col(k).dot(total) * weak_directions.col(k);
+    }
+    t = Rigid3d(ExpSO3(total.tail<3>() / length) * initial.rotation(),
+                initial.translation() + total.head<3>());
   }
   result.world_from_scan = t;
   return result;

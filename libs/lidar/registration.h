@@ -4,7 +4,8 @@
 // convergence thresholds or the iteration cap is reached.
 //
 // Degeneracy: the 6x6 normal matrix (rotation columns scaled by the mean sample range so both
-// blocks are unitless, divided by the total weight) is eigen-decomposed; directions whose
+// blocks are unitless, each point weighted by its planarity a2D^2, divided by the total
+// weight) is eigen-decomposed; directions whose
 // eigenvalue is below `degeneracy_threshold` are unobservable (a corridor along its axis). The
 // update is then restricted to the observable directions, so the pose keeps the initial guess
 // (the constant-velocity motion model) along the degenerate ones, and the result is flagged.
@@ -24,10 +25,10 @@ struct RegistrationOptions {
   double search_radius = 0.6;             // m, r: model neighbours of Eq. (2).
   double max_distance = 0.5;              // m, |I(x)| above this: no correspondence.
   double robust_scale = 0.1;              // m, Cauchy scale on I(x).
-  double convergence_translation = 1e-4;  // m per iteration.
-  double convergence_rotation = 1e-5;     // rad per iteration.
+  double convergence_translation = 5e-4;  // m per iteration.
+  double convergence_rotation = 5e-5;     // rad per iteration.
   int min_correspondences = 30;           // fewer: no update, result.ok = false.
-  double degeneracy_threshold = 5e-3;     // On the normalised eigenvalues.
+  double degeneracy_threshold = 2e-3;     // On the normalised eigenvalues.
   void Check() const;
 };
 
@@ -36,16 +37,17 @@ struct RegistrationResult {
   bool ok = false;         // Enough correspondences for an estimate.
   bool converged = false;  // Stopped on the thresholds, not on the iteration cap.
   int iterations = 0;
-  int correspondences = 0;       // At the last iteration.
-  double residual = 0;           // RMS of I(x) over the correspondences, m.
-  bool degenerate = false;       // Some direction fell back to the initial guess.
+  int correspondences = 0;  // At the last iteration.
+  double residual = 0;      // RMS of I(x) over the correspondences, m.
+  bool degenerate = false;  // Some direction fell back to the initial guess.
   int degenerate_directions = 0;
-  double min_eigenvalue = 0;     // Smallest normalised eigenvalue (last iteration).
+  double min_eigenvalue = 0;  // Smallest normalised eigenvalue (last iteration).
 };
 
 // points: sampled scan points in the scan frame. initial: predicted world_from_scan.
-RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points,
-                                const ImlsModel& model, const Rigid3d& initial,
-                                const RegistrationOptions& options, int threads);
+// planarity (optional, a2D per point) weights the observability test by a2D^2.
+RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, const ImlsModel& model,
+                                const Rigid3d& initial, const RegistrationOptions& options,
+                                int threads, const std::vector<double>* planarity = nullptr);
 
 }  // namespace jvl::lidar

@@ -43,9 +43,9 @@ void FitLocalPlane(const std::vector<Eigen::Vector3d>& points,
 void SurfaceOptions::Check() const {
   JVL_CHECK(normal_neighbors >= 3, "--normal-neighbors must be >= 3, got " << normal_neighbors);
   JVL_CHECK(normal_radius > 0, "--normal-radius must be > 0, got " << normal_radius);
-  JVL_CHECK(min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
-            "--min-normal-neighbors must be in [3, --normal-neighbors], got "
-                << min_normal_neighbors);
+  JVL_CHECK(
+      min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
+      "--min-normal-neighbors must be in [3, --normal-neighbors], got " << min_normal_neighbors);
 }
 
 ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
@@ -65,18 +65,21 @@ ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
     for (size_t c = 0; c < cand.size(); ++c) cp[c] = points[cand[c]];
     std::vector<std::pair<double, int>> nn;
     for (const int i : members) {
+      // The k nearest within the radius, kept sorted by (distance, index) - a strict order, so
+      // the set is deterministic - by insertion (k is small; cheaper than a partition).
       nn.clear();
       const Eigen::Vector3d& p = points[i];
       for (size_t c = 0; c < cp.size(); ++c) {
         const double d2 = (cp[c] - p).squaredNorm();
-        if (d2 <= r2) nn.emplace_back(d2, cand[c]);
+        if (d2 > r2) continue;
+        const std::pair<double, int> e(d2, cand[c]);
+        if (nn.size() == k) {
+          if (!(e < nn.back())) continue;
+          nn.pop_back();
+        }
+        nn.insert(std::upper_bound(nn.begin(), nn.end(), e), e);
       }
       if (nn.size() < static_cast<size_t>(options.min_normal_neighbors)) continue;
-      // The k nearest, (distance, index) pairs are unique so the set is deterministic.
-      if (nn.size() > k) {
-        std::nth_element(nn.begin(), nn.begin() + static_cast<std::ptrdiff_t>(k), nn.end());
-        nn.resize(k);
-      }
       FitLocalPlane(points, nn, i, &s);
     }
   });
@@ -110,8 +113,8 @@ std::array<std::vector<int>, 9> SamplingLists(const ScanSurface& surface, size_t
       return value[a] > value[b] || (value[a] == value[b] && a < b);
     };
     auto& list = lists[k];
-    std::nth_element(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(keep) - 1,
-                     list.end(), before);
+    std::nth_element(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(keep) - 1, list.end(),
+                     before);
     list.resize(keep);
     std::sort(list.begin(), list.end(), before);
   }

@@ -20,7 +20,7 @@ struct SurfaceOptions {
 struct ScanSurface {
   std::vector<Eigen::Vector3d> points;   // Scan (cam0) frame.
   std::vector<Eigen::Vector3d> normals;  // Unit, oriented towards the sensor; zero if invalid.
-  std::vector<double> planarity;         // a2D = (s2 - s3) / s1, s_i = sqrt(lambda_i); 0 if invalid.
+  std::vector<double> planarity;  // a2D = (s2 - s3) / s1, s_i = sqrt(lambda_i); 0 if invalid.
   std::vector<uint8_t> valid;
   size_t size() const { return points.size(); }
 };

@@ -11,15 +11,16 @@
 namespace jvl::lidar::testing {
 
 struct TrajectoryErrors {
-  double ape_rmse = 0;    // m, after SE(3) alignment of all positions.
-  double end_drift = 0;   // m, |end error| with both trajectories anchored at the first frame.
-  double distance = 0;    // m, ground-truth path length.
+  double ape_rmse = 0;   // m, after SE(3) alignment of all positions.
+  double end_drift = 0;  // m, |end error| with both trajectories anchored at the first frame.
+  double distance = 0;   // m, ground-truth path length.
   double drift_fraction() const { return distance > 0 ? end_drift / distance : 0; }
 };
 
 // Umeyama (1991) without scale: R, t minimising sum |gt_i - (R est_i + t)|^2.
-inline void AlignSE3(const std::vector<Eigen::Vector3d>& est, const std::vector<Eigen::Vector3d>& gt,
-                     Eigen::Matrix3d* r, Eigen::Vector3d* t) {
+inline void AlignSE3(const std::vector<Eigen::Vector3d>& est,
+                     const std::vector<Eigen::Vector3d>& gt, Eigen::Matrix3d* r,
+                     Eigen::Vector3d* t) {
   Eigen::Vector3d me = Eigen::Vector3d::Zero(), mg = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < est.size(); ++i) {
     me += est[i];

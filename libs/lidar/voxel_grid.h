@@ -7,7 +7,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -34,6 +33,36 @@ struct CellHash {
     k ^= k >> 33;
     return static_cast<size_t>(k);
   }
+};
+
+// Static open-addressing map from cell key to a non-negative int (linear probing, power-of-two
+// table): lookups are several times faster than std::unordered_map, which dominated the
+// neighbourhood queries of a scan.
+class CellMap {
+ public:
+  explicit CellMap(size_t expected = 0) { Reserve(expected); }
+  void Reserve(size_t expected);
+  // Inserts key -> value if key is absent; returns the value stored for key.
+  int Insert(uint64_t key, int value);
+  // The value of key, or -1.
+  int Find(uint64_t key) const {
+    size_t slot = CellHash()(key) & mask_;
+    while (true) {
+      const Slot& s = slots_[slot];
+      if (s.value < 0) return -1;
+      if (s.key == key) return s.value;
+      slot = (slot + 1) & mask_;
+    }
+  }
+  size_t size() const { return size_; }
+
+ private:
+  struct Slot {
+    uint64_t key = 0;
+    int value = -1;
+  };
+  std::vector<Slot> slots_;
+  size_t mask_ = 0, size_ = 0;
 };
 
 // Indices of the first point (in input order) falling into each voxel, in input order.
@@ -68,9 +97,10 @@ class PointGrid {
 
   const std::vector<Eigen::Vector3d>& points_;
   double cell_size_, inv_cell_;
-  std::vector<int> order_;  // Point indices sorted by cell.
-  std::unordered_map<uint64_t, std::pair<int, int>, CellHash> cells_;  // key -> [begin, end)
+  std::vector<int> order_;           // Point indices sorted by cell.
+  CellMap cells_;                    // key -> index into cell_keys_ / cell_begin_.
   std::vector<uint64_t> cell_keys_;  // Occupied cells in key order.
+  std::vector<int> cell_begin_;      // Range of cell c in order_: [begin[c], begin[c + 1]).
 };
 
 }  // namespace jvl::lidar
