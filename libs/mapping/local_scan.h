@@ -23,7 +23,7 @@ struct ScanOptions {
   lidar::SurfaceOptions surface;
   // Voxel (m) of the copy kept for the artifact's "scans" group (global optimisation and the
   // PLY map read it instead of the dataset). <= 0 keeps every model point.
-  double stored_voxel = 0.3;
+  double stored_voxel = 0.4;
   void Check() const;
 };
 
