@@ -35,9 +35,9 @@ struct LocalMapData {
   Trajectory keyframes;  // Refined world_from_cam0 of each keyframe.
   std::vector<int32_t> imls_n, imls_c;
   std::vector<double> imls_p_x, imls_p_y, imls_normal;  // L x 3 each.
-  std::vector<double> mappoint_position;                 // M x 3.
-  std::vector<int64_t> scan_offset;                      // K + 1, rows of scan_points.
-  std::vector<float> scan_points, scan_normals;          // S x 3 each.
+  std::vector<double> mappoint_position;                // M x 3.
+  std::vector<int64_t> scan_offset;                     // K + 1, rows of scan_points.
+  std::vector<float> scan_points, scan_normals;         // S x 3 each.
   std::vector<int64_t> stats_frame;
   std::vector<int32_t> stats_visual_residuals, stats_imls_residuals;
   std::vector<double> stats_cost_before, stats_cost_after, stats_time_ms;
@@ -51,8 +51,7 @@ struct LocalMapData {
   void Check(const std::string& what) const;
 };
 
-void WriteLocalMap(const std::string& path, const LocalMapData& data,
-                   const Provenance& provenance);
+void WriteLocalMap(const std::string& path, const LocalMapData& data, const Provenance& provenance);
 LocalMapData ReadLocalMap(const std::string& path);
 
 }  // namespace jvl::io

@@ -80,8 +80,8 @@ std::vector<optim::ImlsCorrespondence> LocalMapper::Associate(size_t n, size_t s
     scans.push_back(&scans_.at(r));
     rows.push_back(static_cast<int64_t>(r));
   }
-  const lidar::ImlsModel model = BuildScanModel(scans, rows, result_.poses,
-                                                options_.association.search_radius);
+  const lidar::ImlsModel model =
+      BuildScanModel(scans, rows, result_.poses, options_.association.search_radius);
   return AssociateScan(static_cast<int64_t>(n), scans_.at(n), result_.poses[n], model,
                        result_.poses, options_.association);
 }
@@ -163,8 +163,7 @@ KeyframeStats LocalMapper::Process(size_t n, const ScanLoader& load_scan) {
   stats.frame = in_.frames[n];
   if (n > 0 && options_.propagate_corrections) {
     // Keep the prior motion from the (refined) previous keyframe.
-    result_.poses[n] =
-        result_.poses[n - 1] * (in_.prior[n - 1].Inverse() * in_.prior[n]);
+    result_.poses[n] = result_.poses[n - 1] * (in_.prior[n - 1].Inverse() * in_.prior[n]);
   }
   const Rigid3d initial = result_.poses[n];
   scans_[n] = load_scan(n);
@@ -172,8 +171,8 @@ KeyframeStats LocalMapper::Process(size_t n, const ScanLoader& load_scan) {
   stats.scan_ms = timer.ElapsedMs();
 
   const std::vector<int64_t> local = LocalKeyframes(n, adjacency_);
-  const size_t start = StartKeyframe(in_.frames, n, options_.scan_map_size,
-                                     options_.min_model_keyframes);
+  const size_t start =
+      StartKeyframe(in_.frames, n, options_.scan_map_size, options_.min_model_keyframes);
   stats.local_keyframes = static_cast<int>(local.size());
   stats.model_keyframes = static_cast<int>(n - start);
   std::vector<optim::ImlsCorrespondence> fresh;

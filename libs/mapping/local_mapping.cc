@@ -54,7 +54,8 @@ LocalMappingInput MakeLocalMappingInput(const io::VisualMapData& visual, const T
     in.observations.push_back(obs);
   }
   for (size_t e = 0; e < visual.num_edges(); ++e) {
-    in.covisibility.push_back({visual.covisibility_edges[2 * e], visual.covisibility_edges[2 * e + 1]});
+    in.covisibility.push_back(
+        {visual.covisibility_edges[2 * e], visual.covisibility_edges[2 * e + 1]});
   }
   in.Check();
   return in;

@@ -32,10 +32,10 @@ namespace jvl::mapping {
 
 struct LocalMappingInput {
   PinholeCamera camera;
-  std::vector<int64_t> frames;     // Keyframe frame ids, increasing.
-  std::vector<Rigid3d> map_poses;  // Poses the map points were triangulated with.
-  std::vector<Rigid3d> prior;      // Initial world_from_cam0 of each keyframe.
-  std::vector<Eigen::Vector3d> map_points;             // World, in the map_poses frame.
+  std::vector<int64_t> frames;              // Keyframe frame ids, increasing.
+  std::vector<Rigid3d> map_poses;           // Poses the map points were triangulated with.
+  std::vector<Rigid3d> prior;               // Initial world_from_cam0 of each keyframe.
+  std::vector<Eigen::Vector3d> map_points;  // World, in the map_poses frame.
   std::vector<optim::VisualObservation> observations;  // keyframe = row.
   std::vector<std::array<int, 2>> covisibility;        // Keyframe rows.
   size_t size() const { return frames.size(); }
@@ -79,9 +79,9 @@ struct KeyframeStats {
   double cost_before = 0, cost_after = 0;  // Ceres cost (0.5 weighted sum), first/last round.
   double beta = 0;                         // Weight used.
   int iterations = 0;
-  bool optimized = false;     // A solve ran and was usable.
-  double correction_m = 0;    // |t| of K_n's pose change by this keyframe's optimisation.
-  double time_ms = 0;         // Whole keyframe including its scan preparation.
+  bool optimized = false;   // A solve ran and was usable.
+  double correction_m = 0;  // |t| of K_n's pose change by this keyframe's optimisation.
+  double time_ms = 0;       // Whole keyframe including its scan preparation.
   double scan_ms = 0, solve_ms = 0;
 };
 
@@ -90,8 +90,8 @@ struct StoredScan {
 };
 
 struct LocalMappingResult {
-  std::vector<Rigid3d> poses;               // Refined world_from_cam0 per keyframe.
-  std::vector<Eigen::Vector3d> map_points;  // Refined (rows of the input).
+  std::vector<Rigid3d> poses;                              // Refined world_from_cam0 per keyframe.
+  std::vector<Eigen::Vector3d> map_points;                 // Refined (rows of the input).
   std::vector<optim::ImlsCorrespondence> correspondences;  // L; n, c are keyframe rows.
   std::vector<StoredScan> scans;                           // Per keyframe.
   std::vector<KeyframeStats> stats;

@@ -8,6 +8,8 @@
 
 #include "core/timer.h"
 #include "io/dataset.h"
+#include "io/local_io.h"
+#include "io/schema_check.h"
 #include "io/trajectory_io.h"
 #include "lidar/odometry.h"
 #include "mapping/local_mapping.h"
@@ -26,6 +28,7 @@ const std::string kRoot = std::string(JVL_SOURCE_DIR) + "/../shared/data/kitti_o
 struct KittiLocalRun {
   double prior_ape = 0, local_ape = 0, median_ms = 0;
   size_t keyframes = 0;
+  LocalMappingInput input;
   LocalMappingResult result;
 };
 
@@ -53,9 +56,10 @@ KittiLocalRun RunKittiLocal(const io::Dataset& dataset, const Trajectory& prior,
       dataset.calibration().Camera(0), prior, {},
       [&](int64_t f) { return dataset.LoadImage(f, 0); }, VisualMapOptions(), 2);
   const io::VisualMapData visual = ExportVisualMap(visual_result.map, prior, 15);
-  const LocalMappingInput input = MakeLocalMappingInput(visual, prior, "prior");
-  const Rigid3d cam0_from_velo = dataset.calibration().cam0_from_velo;
   KittiLocalRun run;
+  run.input = MakeLocalMappingInput(visual, prior, "prior");
+  const LocalMappingInput& input = run.input;
+  const Rigid3d cam0_from_velo = dataset.calibration().cam0_from_velo;
   run.result = RunLocalMapping(
       input,
       [&](size_t row) {
@@ -80,14 +84,30 @@ TEST(KittiLocal, LidarOdometryPriorIsNotMadeWorse) {
   const auto dataset = OpenKitti("0:51");
   const Trajectory prior = LidarPrior(*dataset, 1);
   const KittiLocalRun run = RunKittiLocal(*dataset, prior, LocalMappingOptions());
-  std::printf("KITTI 04 0-50, lidar_odom N=1 prior: %zu keyframes, keyframe APE prior %.3f m -> "
-              "local %.3f m, median %.0f ms per keyframe\n",
-              run.keyframes, run.prior_ape, run.local_ape, run.median_ms);
+  std::printf(
+      "KITTI 04 0-50, lidar_odom N=1 prior: %zu keyframes, keyframe APE prior %.3f m -> "
+      "local %.3f m, median %.0f ms per keyframe\n",
+      run.keyframes, run.prior_ape, run.local_ape, run.median_ms);
   EXPECT_GE(run.keyframes, 8u);
   EXPECT_LE(run.local_ape, run.prior_ape * 1.0 + 1e-3);
   size_t optimized = 0;
   for (const auto& s : run.result.stats) optimized += s.optimized;
   EXPECT_GE(optimized, run.keyframes - 1);
+  // The artifact of a real run matches its schema and reads back.
+  const std::string path = (fs::temp_directory_path() / "jvl_local_kitti_test.h5").string();
+  const LocalMappingOptions options;
+  io::WriteLocalMap(
+      path, ExportLocalMap(run.input, run.result, prior, SummarizeLocalMap(run.result, options)),
+      io::Provenance{});
+  for (const auto& p :
+       io::CheckH5AgainstSchema(path, std::string(JVL_SOURCE_DIR) + "/schemas/local.schema.json")) {
+    ADD_FAILURE() << p;
+  }
+  const io::LocalMapData back = io::ReadLocalMap(path);
+  EXPECT_EQ(back.keyframes.frames, run.input.frames);
+  EXPECT_EQ(back.num_correspondences(), run.result.correspondences.size());
+  EXPECT_GT(back.num_scan_points(), 1000 * run.keyframes);
+  fs::remove(path);
 }
 
 TEST(KittiLocal, DriftingPriorIsCorrected) {
@@ -103,9 +123,10 @@ TEST(KittiLocal, DriftingPriorIsCorrected) {
     prior.Append(dataset->frames()[k], drifted[k], dataset->timestamps().at(k));
   }
   const KittiLocalRun run = RunKittiLocal(*dataset, prior, LocalMappingOptions());
-  std::printf("KITTI 04 0-50, drifting prior (0.1 deg + 3 %% per frame): %zu keyframes, keyframe "
-              "APE prior %.3f m -> local %.3f m, median %.0f ms per keyframe\n",
-              run.keyframes, run.prior_ape, run.local_ape, run.median_ms);
+  std::printf(
+      "KITTI 04 0-50, drifting prior (0.1 deg + 3 %% per frame): %zu keyframes, keyframe "
+      "APE prior %.3f m -> local %.3f m, median %.0f ms per keyframe\n",
+      run.keyframes, run.prior_ape, run.local_ape, run.median_ms);
   EXPECT_LE(run.local_ape, 0.5 * run.prior_ape);
 }
 

@@ -29,7 +29,7 @@ TEST(LocalMapping, StartKeyframeIsFirstWithinNFrames) {
   EXPECT_EQ(StartKeyframe(frames, 5, 7, 0), 5u);   // Literal rule: empty S_model.
   EXPECT_EQ(StartKeyframe(frames, 5, 7, 1), 4u);   // At least the previous keyframe.
   EXPECT_EQ(StartKeyframe(frames, 5, 7, 2), 3u);
-  EXPECT_EQ(StartKeyframe(frames, 1, 1, 3), 0u);   // Cannot go before row 0.
+  EXPECT_EQ(StartKeyframe(frames, 1, 1, 3), 0u);  // Cannot go before row 0.
 }
 
 TEST(LocalMapping, LocalKeyframesAreCovisibleEarlierOnesByTime) {
@@ -89,7 +89,7 @@ TEST(LocalMapping, ImlsResidualIsZeroAtTrueConfiguration) {
     max_abs = std::max(max_abs, std::abs(r));
     EXPECT_NEAR(l.c_normal.norm(), 1.0, 1e-12);
   }
-  EXPECT_LT(max_abs, 1e-9);
+  EXPECT_LT(max_abs, 1e-4);     // The IMLS model stores single-precision points (0.1 mm here).
   EXPECT_GE(per_c.size(), 2u);  // c is the keyframe of the nearest model point, not always one.
   // Away from the truth the same correspondences are violated.
   const Rigid3d moved = truth[3] * Rigid3d(Eigen::Quaterniond::Identity(), {0.1, -0.05, 0.2});

@@ -74,8 +74,8 @@ KeyframeScan KeyframeScanFromSurface(const std::vector<Eigen::Vector3d>& points,
 lidar::ImlsModel BuildScanModel(const std::vector<const KeyframeScan*>& scans,
                                 const std::vector<int64_t>& rows,
                                 const std::vector<Rigid3d>& world_from_cam, double cell_size) {
-  JVL_CHECK(scans.size() == rows.size(), "scan model: " << scans.size() << " scans for "
-                                                        << rows.size() << " keyframes");
+  JVL_CHECK(scans.size() == rows.size(),
+            "scan model: " << scans.size() << " scans for " << rows.size() << " keyframes");
   lidar::ImlsModel model(cell_size);
   std::vector<Eigen::Vector3d> points, normals;
   for (size_t k = 0; k < scans.size(); ++k) {
@@ -100,10 +100,9 @@ std::vector<optim::ImlsCorrespondence> AssociateScan(int64_t n, const KeyframeSc
   if (model.size() == 0 || scan.points.empty()) return out;
   const double r = options.search_radius;
   // IMLS-SLAM sampling: s points per list that have a model neighbour at the current pose.
-  const std::vector<int> picked =
-      lidar::SelectSamples(scan.lists, scan.points.size(), options.samples_per_list, [&](int i) {
-        return model.HasNeighbor(world_from_n * scan.points[i], r);
-      });
+  const std::vector<int> picked = lidar::SelectSamples(
+      scan.lists, scan.points.size(), options.samples_per_list,
+      [&](int i) { return model.HasNeighbor(world_from_n * scan.points[i], r); });
   for (const int i : picked) {
     lidar::ImlsProjection proj;
     // Eq. (2) in the world frame and p_y = p_x - I(p_x) n_c.

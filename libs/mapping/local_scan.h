@@ -23,19 +23,19 @@ struct ScanOptions {
   lidar::SurfaceOptions surface;
   // Voxel (m) of the copy kept for the artifact's "scans" group (global optimisation and the
   // PLY map read it instead of the dataset). <= 0 keeps every model point.
-  double stored_voxel = 0.3;
+  double stored_voxel = 0.4;
   void Check() const;
 };
 
 // One keyframe's scan in its own cam0 frame, prepared once and reused by every optimisation the
 // keyframe takes part in.
 struct KeyframeScan {
-  std::vector<Eigen::Vector3d> points;   // Points with a valid normal (the model points).
-  std::vector<Eigen::Vector3d> normals;  // Unit, same rows.
-  std::vector<double> planarity;         // a2D of IMLS-SLAM, same rows.
+  std::vector<Eigen::Vector3d> points;    // Points with a valid normal (the model points).
+  std::vector<Eigen::Vector3d> normals;   // Unit, same rows.
+  std::vector<double> planarity;          // a2D of IMLS-SLAM, same rows.
   std::array<std::vector<int>, 9> lists;  // Sampling lists over the rows above.
   std::vector<Eigen::Vector3d> stored_points, stored_normals;  // Voxel-downsampled copy.
-  int64_t raw_points = 0;                                       // Input scan size.
+  int64_t raw_points = 0;                                      // Input scan size.
 };
 
 // Preprocessing (supplement 1.1), normals and sampling lists (IMLS-SLAM Sec. V) of a velodyne

@@ -28,12 +28,12 @@ inline std::vector<Patch> StreetPatches() {
   for (int b = 0; b < 10; ++b) {
     const double z = -20 + 15.0 * b;
     const double xl = -8.0 - (b % 3), xr = 8.0 + ((b + 1) % 2) * 1.5;
-    p.push_back({{xl, -6, z}, {0, 0, 11}, {0, 6.7, 0}});       // Left facade block.
-    p.push_back({{xr, -6, z + 2}, {0, 0, 10}, {0, 6.7, 0}});   // Right facade block.
+    p.push_back({{xl, -6, z}, {0, 0, 11}, {0, 6.7, 0}});            // Left facade block.
+    p.push_back({{xr, -6, z + 2}, {0, 0, 10}, {0, 6.7, 0}});        // Right facade block.
     p.push_back({{xl - 5, -6, z + 12.5}, {4, 0, 0}, {0, 6.7, 0}});  // Cross walls (normal z).
     p.push_back({{xr + 1, -6, z + 13.5}, {4, 0, 0}, {0, 6.7, 0}});
   }
-  p.push_back({{2, -1.3, 30}, {2, 0, 0}, {0, 2.5, 0}});  // A box face in the street.
+  p.push_back({{2, -1.3, 30}, {2, 0, 0}, {0, 2.5, 0}});   // A box face in the street.
   p.push_back({{-3, -1.3, 70}, {0, 0, 3}, {0, 2.5, 0}});  // A wall segment along the road.
   return p;
 }
@@ -42,7 +42,8 @@ inline std::vector<Patch> StreetPatches() {
 // offset (different per scan), in the keyframe's cam0 frame, with normals facing the sensor.
 inline void SampleScan(const std::vector<Patch>& patches, const Rigid3d& world_from_cam,
                        double step, double range, uint32_t seed,
-                       std::vector<Eigen::Vector3d>* points, std::vector<Eigen::Vector3d>* normals) {
+                       std::vector<Eigen::Vector3d>* points,
+                       std::vector<Eigen::Vector3d>* normals) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> offset(0.0, 1.0);
   const Rigid3d cam_from_world = world_from_cam.Inverse();
@@ -140,7 +141,8 @@ inline LocalMappingInput MakeVisualInput(const PinholeCamera& camera,
       std::vector<int> shared;
       std::set_intersection(seen_by[a].begin(), seen_by[a].end(), seen_by[b].begin(),
                             seen_by[b].end(), std::back_inserter(shared));
-      if (shared.size() >= 15) in.covisibility.push_back({static_cast<int>(a), static_cast<int>(b)});
+      if (shared.size() >= 15)
+        in.covisibility.push_back({static_cast<int>(a), static_cast<int>(b)});
     }
   }
   return in;

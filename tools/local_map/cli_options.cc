@@ -29,8 +29,8 @@ void AddLocalMapFlags(CLI::App& cli, mapping::LocalMappingOptions* o, mapping::S
   add("--visual-huber", o->joint.visual_huber, "Huber threshold of e_V (whitened)", method);
 
   const std::string imls = "IMLS";
-  add("--samples-per-list", o->association.samples_per_list,
-      "s: points per sampling list (x9)", imls);
+  add("--samples-per-list", o->association.samples_per_list, "s: points per sampling list (x9)",
+      imls);
   add("--imls-h", o->association.kernel_h, "Kernel width h of Eq. (2) (m)", imls);
   add("--imls-radius", o->association.search_radius, "Neighbourhood radius r (m)", imls);
   add("--imls-max-distance", o->association.max_distance,

@@ -58,12 +58,12 @@ int main(int argc, char** argv) {
         },
         options, tool.threads(),
         [&](size_t, const mapping::KeyframeStats& s) {
-          spdlog::debug("keyframe {}: local {}, model {}, fixed {}, visual {}, imls {} ({} new, {} "
-                        "reused), cost {:.1f} -> {:.1f}, moved {:.3f} m, {:.0f} ms",
-                        s.frame, s.local_keyframes, s.model_keyframes, s.fixed_keyframes,
-                        s.visual_residuals, s.imls_residuals, s.new_correspondences,
-                        s.reused_correspondences, s.cost_before, s.cost_after, s.correction_m,
-                        s.time_ms);
+          spdlog::debug(
+              "keyframe {}: local {}, model {}, fixed {}, visual {}, imls {} ({} new, {} "
+              "reused), cost {:.1f} -> {:.1f}, moved {:.3f} m, {:.0f} ms",
+              s.frame, s.local_keyframes, s.model_keyframes, s.fixed_keyframes, s.visual_residuals,
+              s.imls_residuals, s.new_correspondences, s.reused_correspondences, s.cost_before,
+              s.cost_after, s.correction_m, s.time_ms);
           progress.Tick();
         });
     const nlohmann::json summary = mapping::SummarizeLocalMap(result, options);
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
       io::WriteTrajectoryKitti(kitti_poses, mapping::RefinedKeyframes(input, result));
     }
     std::printf("%s\n", summary.dump().c_str());
-    spdlog::info("local_map: {} keyframes, {:.0f} ms median per keyframe; wrote {}",
-                 input.size(), summary.at("median_time_ms").get<double>(), output);
+    spdlog::info("local_map: {} keyframes, {:.0f} ms median per keyframe; wrote {}", input.size(),
+                 summary.at("median_time_ms").get<double>(), output);
   });
 }
