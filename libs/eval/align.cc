@@ -65,6 +65,8 @@ Similarity Umeyama(const std::vector<Eigen::Vector3d>& src, const std::vector<Ei
   sim.rotation = svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
   sim.scale = with_scale ? svd.singularValues().dot(s) / var_src : 1.0;
   sim.translation = mean_dst - sim.scale * sim.rotation * mean_src;
+  const Eigen::Vector3d sv = svd.singularValues();
+  sim.conditioning = sv(0) > 0 ? sv(1) / sv(0) : 0.0;
   return sim;
 }
 

@@ -16,6 +16,12 @@ struct Similarity {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   double scale = 1.0;
+  // Second over first singular value of the position cross-covariance (1 for a well spread
+  // trajectory). Near 0 the positions lie on a line, and the rotation about that line, hence
+  // the aligned rotation errors, are not determined by the positions.
+  double conditioning = 1.0;
+  bool IllConditioned() const { return conditioning < kMinConditioning; }
+  static constexpr double kMinConditioning = 1e-3;
 
   // The pose moved by the similarity: its translation is scaled, then rotated and shifted; its
   // rotation block is rotated (the order kitti-odom-eval and evo use).

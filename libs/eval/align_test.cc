@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <Eigen/Geometry>
 #include <random>
 
@@ -58,6 +60,17 @@ TEST(Similarity, ApplyScalesTranslationThenMoves) {
   EXPECT_TRUE((out.topLeftCorner<3, 3>().isApprox(sim.rotation)));
   EXPECT_EQ(ParseAlignment("sim3"), Alignment::kSim3);
   EXPECT_THROW(ParseAlignment("7dof"), Error);
+}
+
+TEST(AlignTest, CollinearPositionsAreFlaggedIllConditioned) {
+  std::vector<Eigen::Vector3d> line, spread;
+  for (int i = 0; i < 50; ++i) {
+    line.emplace_back(0.0, 0.0, 1.5 * i);
+    spread.emplace_back(std::sin(0.1 * i) * 20, 0.5 * std::cos(0.3 * i), 1.5 * i);
+  }
+  EXPECT_TRUE(Umeyama(line, line, false).IllConditioned());
+  EXPECT_LT(Umeyama(line, line, false).conditioning, 1e-9);
+  EXPECT_FALSE(Umeyama(spread, spread, false).IllConditioned());
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ nlohmann::json AlignmentToJson(const SequenceEval& s, const EvalOptions& options
   j["translation"] = {s.alignment.translation.x(), s.alignment.translation.y(),
                       s.alignment.translation.z()};
   j["scale"] = s.alignment.scale;
+  j["conditioning"] = s.alignment.conditioning;
   return j;
 }
 

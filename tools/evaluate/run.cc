@@ -66,6 +66,13 @@ void LogMatching(const std::string& label, const eval::SequenceEval& s) {
         "(first: {})",
         label, s.name, s.gt_missing_frames.size(), s.gt_missing_frames.front());
   }
+  if (s.alignment.IllConditioned()) {
+    spdlog::warn(
+        "{} / {}: the matched positions are nearly collinear (conditioning {:.2g}): the alignment "
+        "cannot fix the rotation about the direction of travel, so aligned rotation errors are "
+        "not meaningful; use --align origin or none for rotations",
+        label, s.name, s.alignment.conditioning);
+  }
   if (!s.est_unmatched_frames.empty()) {
     spdlog::warn("{} / {}: {} estimated pose(s) have no ground truth (first frame: {})", label,
                  s.name, s.est_unmatched_frames.size(), s.est_unmatched_frames.front());
