@@ -1,6 +1,7 @@
 #include "io/local_io.h"
 
 #include "core/check.h"
+#include "io/camera_io.h"
 #include "io/trajectory_io.h"
 
 namespace jvl::io {
@@ -50,9 +51,7 @@ void WriteLocalMap(const std::string& path, const LocalMapData& d, const Provena
   const int64_t l = static_cast<int64_t>(d.num_correspondences());
   const int64_t s = static_cast<int64_t>(d.num_scan_points());
   H5Writer w(path, kLocalSchema, kLocalSchemaVersion);
-  const PinholeCamera& c = d.camera;
-  w.WriteArray<double>("camera", {c.fx, c.fy, c.cx, c.cy, static_cast<double>(c.width),
-                                  static_cast<double>(c.height)});
+  WriteCameraArray(w, "camera", d.camera);
   WriteTrajectoryGroup(w, "keyframes", d.keyframes);
   w.WriteArray("imls/n", d.imls_n);
   w.WriteArray("imls/c", d.imls_c);
@@ -78,9 +77,7 @@ void WriteLocalMap(const std::string& path, const LocalMapData& d, const Provena
 LocalMapData ReadLocalMap(const std::string& path) {
   H5Reader r(path, kLocalSchema, kLocalSchemaVersion);
   LocalMapData d;
-  const auto cam = r.ReadArray<double>("camera");
-  JVL_CHECK(cam.size() == 6, path << ": camera must have 6 values, has " << cam.size());
-  d.camera = {cam[0], cam[1], cam[2], cam[3], static_cast<int>(cam[4]), static_cast<int>(cam[5])};
+  d.camera = ReadCameraArray(r, "camera");
   d.keyframes = ReadTrajectoryGroup(r, "keyframes");
   d.imls_n = r.ReadArray<int32_t>("imls/n");
   d.imls_c = r.ReadArray<int32_t>("imls/c");

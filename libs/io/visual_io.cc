@@ -1,6 +1,7 @@
 #include "io/visual_io.h"
 
 #include "core/check.h"
+#include "io/camera_io.h"
 #include "io/trajectory_io.h"
 
 namespace jvl::io {
@@ -53,9 +54,7 @@ void WriteVisualMap(const std::string& path, const VisualMapData& d, const Prove
   const int64_t p = static_cast<int64_t>(d.num_keypoints());
   const int64_t m = static_cast<int64_t>(d.num_mappoints());
   H5Writer w(path, kVisualSchema, kVisualSchemaVersion);
-  const PinholeCamera& c = d.camera;
-  w.WriteArray<double>("camera", {c.fx, c.fy, c.cx, c.cy, static_cast<double>(c.width),
-                                  static_cast<double>(c.height)});
+  WriteCameraArray(w, "camera", d.camera);
   w.WriteJson("orb", {{"scale_factor", d.scale_factor}, {"num_levels", d.num_levels}});
   WriteTrajectoryGroup(w, "keyframes", d.keyframes);
   w.WriteArray("keypoints/keyframe", d.keypoint_keyframe);
@@ -80,9 +79,7 @@ void WriteVisualMap(const std::string& path, const VisualMapData& d, const Prove
 VisualMapData ReadVisualMap(const std::string& path) {
   H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
   VisualMapData d;
-  const auto cam = r.ReadArray<double>("camera");
-  JVL_CHECK(cam.size() == 6, path << ": camera must have 6 values, has " << cam.size());
-  d.camera = {cam[0], cam[1], cam[2], cam[3], static_cast<int>(cam[4]), static_cast<int>(cam[5])};
+  d.camera = ReadCameraArray(r, "camera");
   const nlohmann::json orb = r.ReadJson("orb");
   d.scale_factor = orb.at("scale_factor").get<double>();
   d.num_levels = orb.at("num_levels").get<int>();

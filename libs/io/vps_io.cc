@@ -5,17 +5,15 @@
 
 #include "core/check.h"
 #include "core/strings.h"
+#include "io/camera_io.h"
 #include "io/files.h"
 
 namespace jvl::io {
 
 void WriteVps(H5Writer& writer, const VpsData& data) {
   const int64_t m = static_cast<int64_t>(data.vps.size());
-  const PinholeCamera& c = data.camera;
   writer.WriteArray("frames", data.frames);
-  writer.WriteArray("camera",
-                    std::vector<double>{c.fx, c.fy, c.cx, c.cy, static_cast<double>(c.width),
-                                        static_cast<double>(c.height)});
+  WriteCameraArray(writer, "camera", data.camera);
   std::vector<int64_t> frame;
   std::vector<int32_t> index, inliers;
   std::vector<double> uv, direction, residual, score;
@@ -50,14 +48,7 @@ VpsData ReadVpsArtifact(const std::string& path) {
   H5Reader reader(path, kVpsSchema, kVpsSchemaVersion);
   VpsData data;
   data.frames = reader.ReadArray<int64_t>("frames");
-  const auto camera = reader.ReadArray<double>("camera");
-  JVL_CHECK(camera.size() == 6, path << ": 'camera' must hold 6 values, found " << camera.size());
-  data.camera = {camera[0],
-                 camera[1],
-                 camera[2],
-                 camera[3],
-                 static_cast<int>(camera[4]),
-                 static_cast<int>(camera[5])};
+  data.camera = ReadCameraArray(reader, "camera");
   const auto frame = reader.ReadArray<int64_t>("vps/frame");
   const auto index = reader.ReadArray<int32_t>("vps/index");
   const auto uv = reader.ReadArray<double>("vps/uv", 2);
