@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_set>
 
 #include "core/check.h"
@@ -15,6 +16,22 @@
 #include "lidar/voxel_grid.h"
 
 namespace jvl::mapping {
+
+namespace {
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+}
+
+// Median (upper for even sizes); NaN if empty.
+double Median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace
 
 void GlobalMapInput::Check() const {
   keyframes.Check("global input keyframes");
@@ -49,6 +66,24 @@ void GlobalMappingOptions::Check() const {
   traversal.Check();
   JVL_CHECK(rounds >= 1, "rounds must be >= 1, got " << rounds);
   JVL_CHECK(first_direction_round >= 0, "first_direction_round must be >= 0");
+  JVL_CHECK(std::isfinite(refit_outlier_deg) && refit_outlier_deg > 0 && refit_outlier_deg < 90,
+            "refit outlier threshold must be in (0, 90) degrees, got " << refit_outlier_deg);
+  JVL_CHECK(refit_min_support >= 1, "refit minimum support must be >= 1");
+  JVL_CHECK(std::isfinite(direction_sigma_px) && std::isfinite(min_direction_sigma_px) &&
+                min_direction_sigma_px > 0,
+            "direction sigma must be finite and its minimum positive");
+}
+
+const char* ToString(GlobalMappingOptions::DirectionSource source) {
+  switch (source) {
+    case GlobalMappingOptions::DirectionSource::kPrior:
+      return "prior";
+    case GlobalMappingOptions::DirectionSource::kRefit:
+      return "refit";
+    case GlobalMappingOptions::DirectionSource::kFree:
+      return "free";
+  }
+  return "?";
 }
 
 DirectionSelection SelectDirections(const Trajectory& keyframes,
@@ -69,8 +104,95 @@ DirectionSelection SelectDirections(const Trajectory& keyframes,
               "direction prior of cluster " << a.cluster << " (frame " << a.frame
                                             << ") is not a unit vector");
     out.constraints.push_back({static_cast<int64_t>(*row), a.uv, a.direction_world.normalized()});
+    out.clusters.push_back(a.cluster);
   }
   return out;
+}
+
+DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera& camera,
+                               const DirectionSelection& selection, double outlier_deg,
+                               int min_support) {
+  JVL_CHECK(selection.clusters.size() == selection.constraints.size(),
+            "RefitDirections: " << selection.clusters.size() << " cluster ids for "
+                                << selection.constraints.size() << " constraints");
+  // World direction of every VP under the current rotation, oriented like the old d_w.
+  std::map<int32_t, std::vector<size_t>> members;
+  std::vector<Eigen::Vector3d> rays(selection.constraints.size());
+  for (size_t i = 0; i < selection.constraints.size(); ++i) {
+    const auto& c = selection.constraints[i];
+    JVL_CHECK(c.keyframe >= 0 && static_cast<size_t>(c.keyframe) < keyframes.size(),
+              "RefitDirections: keyframe row " << c.keyframe << " out of range");
+    const Eigen::Vector3d cam_ray = camera.Unproject(c.vp).normalized();
+    Eigen::Vector3d w = keyframes.world_from_cam[c.keyframe].rotation() * cam_ray;
+    if (w.dot(c.direction_world) < 0) w = -w;
+    rays[i] = w;
+    members[selection.clusters[i]].push_back(i);
+  }
+  DirectionRefit out;
+  out.selection.not_keyframe = selection.not_keyframe;
+  out.selection.at_infinity = selection.at_infinity;
+  for (const auto& [cluster, idx] : members) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    for (size_t i : idx) d += rays[i];
+    d.normalize();
+    // Robust mean: gate = max(outlier_deg, 3 sigma) with sigma from the median angle to the
+    // current mean (2D Gaussian: median = 1.1774 sigma); iterate to a fixed point.
+    std::vector<size_t> kept = idx;
+    for (int it = 0; it < 20; ++it) {
+      std::vector<double> angles;
+      for (size_t i : kept) angles.push_back(AngleDeg(rays[i], d));
+      const double median = Median(angles);
+      const double gate = std::max(outlier_deg, 3.0 * median / 1.1774);
+      std::vector<size_t> next;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (size_t i : idx)
+        if (AngleDeg(rays[i], d) <= gate) {
+          next.push_back(i);
+          sum += rays[i];
+        }
+      if (next.empty()) {
+        kept.clear();
+        break;
+      }
+      const bool stable = next == kept;
+      kept = std::move(next);
+      d = sum.normalized();
+      if (stable) break;
+    }
+    out.outliers += static_cast<int64_t>(idx.size() - kept.size());
+    if (static_cast<int>(kept.size()) < min_support) {
+      out.small_cluster_vps += static_cast<int64_t>(kept.size());
+      continue;
+    }
+    out.directions[cluster] = d;
+    const Eigen::Vector3d old = selection.constraints[idx.front()].direction_world;
+    out.change_deg[cluster] = std::acos(std::clamp(old.dot(d), -1.0, 1.0)) * 180.0 / M_PI;
+    for (size_t i : kept) {
+      optim::DirectionConstraint c = selection.constraints[i];
+      c.direction_world = d;
+      out.selection.constraints.push_back(c);
+      out.selection.clusters.push_back(cluster);
+    }
+  }
+  return out;
+}
+
+double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
+                            const std::vector<optim::DirectionConstraint>& constraints,
+                            const std::vector<Eigen::Vector3d>& free_directions) {
+  std::vector<double> e;
+  e.reserve(constraints.size());
+  for (const auto& c : constraints) {
+    const Eigen::Vector3d& d_w =
+        c.free_direction >= 0 ? free_directions.at(static_cast<size_t>(c.free_direction))
+                              : c.direction_world;
+    Eigen::Vector3d d =
+        keyframes.world_from_cam.at(static_cast<size_t>(c.keyframe)).rotation().inverse() * d_w;
+    if (d.z() < 0) d = -d;  // unoriented, as in the cost
+    if (d.z() < 1e-6) continue;
+    e.push_back((camera.Project(d) - c.vp).norm());
+  }
+  return Median(std::move(e));
 }
 
 namespace {
@@ -170,6 +292,43 @@ std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
   return out;
 }
 
+namespace {
+
+// The direction constraints of the first round with e_D: as selected (kPrior), with re-estimated
+// fixed d_w (kRefit) or with one free d_w block per cluster initialised by the re-estimate
+// (kFree); VPs far from their cluster's direction are dropped in both re-estimated forms.
+void PrepareDirections(const Trajectory& keyframes, const PinholeCamera& camera,
+                       const DirectionSelection& dirs, const GlobalMappingOptions& options,
+                       optim::JointProblemInput* problem, GlobalMappingResult* result) {
+  using Source = GlobalMappingOptions::DirectionSource;
+  problem->free_directions.clear();
+  if (options.direction_source == Source::kPrior) {
+    problem->directions = dirs.constraints;
+    return;
+  }
+  const DirectionRefit refit = RefitDirections(keyframes, camera, dirs, options.refit_outlier_deg,
+                                               options.refit_min_support);
+  problem->directions = refit.selection.constraints;
+  result->directions_outliers = refit.outliers;
+  result->directions_small_cluster = refit.small_cluster_vps;
+  result->direction_change_deg = refit.change_deg;
+  result->directions_used = static_cast<int64_t>(problem->directions.size());
+  for (const auto& [cluster, change] : refit.change_deg)
+    spdlog::debug("direction prior of cluster {} re-estimated: moved {:.3f} deg", cluster, change);
+  if (options.direction_source != Source::kFree) return;
+  std::map<int32_t, int32_t> block_of;
+  result->free_direction_clusters.clear();
+  for (const auto& [cluster, d] : refit.directions) {
+    block_of[cluster] = static_cast<int32_t>(problem->free_directions.size());
+    problem->free_directions.push_back(d);
+    result->free_direction_clusters.push_back(cluster);
+  }
+  for (size_t i = 0; i < problem->directions.size(); ++i)
+    problem->directions[i].free_direction = block_of.at(refit.selection.clusters[i]);
+}
+
+}  // namespace
+
 GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
                                    const GlobalMappingOptions& options) {
   const Timer total;
@@ -189,13 +348,40 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   result.keyframes = input.keyframes;
   const bool fresh = options.fresh_traversal && !input.scans.empty();
   const int rounds = fresh ? options.rounds : 1;
+  std::vector<optim::DirectionConstraint> active;  // e_D's constraints once they enter
+  std::vector<Eigen::Vector3d> free_directions;   // DirectionSource::kFree: current d_w
+  bool refitted = false;
+  optim::JointProblemOptions joint = options.joint;  // direction sigma set once e_D enters
   optim::JointCostBreakdown first_before;
   for (int round = 0; round < rounds; ++round) {
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
     problem.directions.clear();
-    if (options.use_directions && round >= std::min(options.first_direction_round, rounds - 1))
-      problem.directions = dirs.constraints;
+    if (options.use_directions && round >= std::min(options.first_direction_round, rounds - 1)) {
+      if (!refitted) {
+        PrepareDirections(result.keyframes, input.camera, dirs, options, &problem, &result);
+        active = problem.directions;
+        free_directions = problem.free_directions;
+        refitted = true;
+        if (options.direction_sigma_px > 0) {
+          result.direction_sigma_px = options.direction_sigma_px;
+        } else {
+          // 2D Gaussian: median |e| = sigma sqrt(2 ln 2). Measured at the warm-started poses, so
+          // it also holds what is left of the drift: an upper bound of the VP noise.
+          const double sigma =
+              MedianDirectionError(result.keyframes, input.camera, active, free_directions) /
+              std::sqrt(2.0 * M_LN2);
+          result.direction_sigma_px = std::isfinite(sigma)
+                                          ? std::max(options.min_direction_sigma_px, sigma)
+                                          : 1.0;
+          result.direction_sigma_estimated = true;
+          spdlog::debug("e_D sigma estimated: {:.3f} px", result.direction_sigma_px);
+        }
+        joint.direction_sigma_px = result.direction_sigma_px;
+      }
+      problem.directions = active;
+      problem.free_directions = free_directions;
+    }
     problem.imls.clear();
     if (options.use_saved_imls) problem.imls = input.saved_imls;
     result.saved_imls = static_cast<int64_t>(problem.imls.size());
@@ -212,10 +398,10 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
       // Warm-start round without e_D: report the full energy at the input poses anyway.
       optim::JointProblemInput full = problem;
       full.directions = dirs.constraints;
-      auto built = optim::BuildJointProblem(full, options.joint);
+      auto built = optim::BuildJointProblem(full, joint);
       first_before = optim::EvaluateJointCost(built, options.solve.threads);
     }
-    result.solve = optim::OptimizeJoint(problem, options.joint, options.solve);
+    result.solve = optim::OptimizeJoint(problem, joint, options.solve);
     ++result.rounds;
     result.total_iterations += result.solve.iterations;
     if (round == 0 && first_before.total == 0.0) first_before = result.solve.before;
@@ -229,6 +415,10 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       result.keyframes.world_from_cam[i] = result.solve.poses.at(static_cast<int64_t>(i));
     problem.map_points = result.solve.map_points;
+    if (!problem.free_directions.empty()) {
+      free_directions = result.solve.free_directions;
+      result.free_directions = free_directions;
+    }
   }
   result.solve.before = first_before;  // report the costs at the input poses
   result.total_time_s = total.ElapsedSeconds();
@@ -239,6 +429,21 @@ namespace {
 
 nlohmann::json StatsOf(const optim::ResidualStats& s) {
   return {{"count", s.count}, {"cost", s.cost}, {"rms", s.rms}};
+}
+
+nlohmann::json ChangeJson(const std::map<int32_t, double>& change) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [cluster, deg] : change) j[std::to_string(cluster)] = deg;
+  return j;
+}
+
+nlohmann::json FreeJson(const GlobalMappingResult& r) {
+  nlohmann::json j = nlohmann::json::object();
+  for (size_t i = 0; i < r.free_directions.size() && i < r.free_direction_clusters.size(); ++i) {
+    const Eigen::Vector3d& d = r.free_directions[i];
+    j[std::to_string(r.free_direction_clusters[i])] = {d.x(), d.y(), d.z()};
+  }
+  return j;
 }
 
 nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
@@ -262,7 +467,15 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
            {{"used", r.directions_used},
             {"not_keyframe", r.directions_not_keyframe},
             {"at_infinity", r.directions_at_infinity},
-            {"enabled", o.use_directions}}},
+            {"enabled", o.use_directions},
+            {"source", ToString(o.direction_source)},
+            {"refit_outlier_deg", o.refit_outlier_deg},
+            {"sigma_px", r.direction_sigma_px},
+            {"sigma_estimated", r.direction_sigma_estimated},
+            {"outliers", r.directions_outliers},
+            {"small_cluster", r.directions_small_cluster},
+            {"change_deg", ChangeJson(r.direction_change_deg)},
+            {"free", FreeJson(r)}}},
           {"solver",
            {{"usable", s.usable},
             {"iterations", r.total_iterations},

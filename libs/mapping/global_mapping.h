@@ -73,13 +73,42 @@ struct GlobalMappingOptions {
   int rounds = 2;
   // Rounds before this one leave the direction residuals out (0 = directions in every round).
   int first_direction_round = 1;
+  // Where d_w comes from when e_D enters the problem:
+  //  - kPrior: the directions artifact (direction_cluster's d_w, i.e. the prior's rotations;
+  //    the paper's supplement 1.4);
+  //  - kRefit: re-estimated per cluster from the current keyframe rotations (after the warm-start
+  //    rounds) as the robust mean of the back-projected VPs R_wn K^-1 v (RefitDirections; far
+  //    VPs are dropped), then fixed;
+  //  - kFree: as kRefit, but each cluster's d_w is then a free unit-vector block optimised
+  //    with the poses (a landmark at infinity), so that the gauge keyframe and the other terms
+  //    fix its absolute orientation and e_D only makes the cluster's keyframes agree.
+  enum class DirectionSource { kPrior, kRefit, kFree };
+  DirectionSource direction_source = DirectionSource::kFree;
+  double refit_outlier_deg = 1.0;  // smallest outlier gate (see RefitDirections)
+  int refit_min_support = 3;  // clusters with fewer inlier keyframes are left out
+  // sigma of e_D in pixels (its whitening, see JointProblemOptions::direction_sigma_px).
+  // <= 0: estimated when e_D enters the problem from the median of |v - pi(R_nw d_w)| at the
+  // current poses / sqrt(2 ln 2) (2D Gaussian), at least min_direction_sigma_px. The weight
+  // rule then balances whitened residuals.
+  double direction_sigma_px = 0.0;
+  double min_direction_sigma_px = 0.5;
   void Check() const;
 };
 
 struct DirectionSelection {
   std::vector<optim::DirectionConstraint> constraints;  // keyframe = row.
+  std::vector<int32_t> clusters;                        // cluster of each constraint
   int64_t not_keyframe = 0;  // Associations of frames that are not keyframes.
   int64_t at_infinity = 0;   // Non-finite VP (skipped: e_D needs a finite v).
+};
+
+// Direction priors re-estimated from the current keyframe rotations (DirectionSource::kRefit).
+struct DirectionRefit {
+  DirectionSelection selection;                 // inliers with their cluster's new d_w
+  std::map<int32_t, Eigen::Vector3d> directions;  // cluster -> re-estimated d_w (kept clusters)
+  std::map<int32_t, double> change_deg;           // cluster -> angle(old d_w, new d_w)
+  int64_t outliers = 0;            // VPs further than the threshold from their cluster
+  int64_t small_cluster_vps = 0;   // VPs of clusters left with < min_support inliers
 };
 
 struct GlobalMappingResult {
@@ -87,6 +116,14 @@ struct GlobalMappingResult {
   Trajectory keyframes;  // Optimised (same frames as the input keyframes).
   int64_t saved_imls = 0, fresh_imls = 0;
   int64_t directions_used = 0, directions_not_keyframe = 0, directions_at_infinity = 0;
+  // DirectionSource::kRefit: VPs dropped as outliers / in too small clusters, and the change of
+  // each cluster's d_w (degrees) against the directions artifact.
+  int64_t directions_outliers = 0, directions_small_cluster = 0;
+  std::map<int32_t, double> direction_change_deg;
+  double direction_sigma_px = 0;  // sigma of e_D used (given or estimated)
+  std::vector<Eigen::Vector3d> free_directions;  // kFree: optimised d_w per kept cluster
+  std::vector<int32_t> free_direction_clusters;  // cluster id of each free_directions entry
+  bool direction_sigma_estimated = false;
   double traversal_time_s = 0;
   double total_time_s = 0;
   int rounds = 0;
@@ -96,6 +133,24 @@ struct GlobalMappingResult {
 // Direction residual inputs: one per keyframe with an association and a finite VP.
 DirectionSelection SelectDirections(const Trajectory& keyframes,
                                     const std::vector<DirectionAssociation>& associations);
+
+// Re-estimates d_w of every cluster from the rotations of `keyframes` (rows as in `selection`):
+// each VP v of keyframe n gives the world direction R_wn K^-1 v (sign of the old d_w); d_w is
+// their mean over the VPs within a gate of max(outlier_deg, 3 sigma) of it, sigma from the
+// median angle (iterated to a fixed point; drops the VPs of turn exits and mismatched lines).
+// Clusters with fewer than `min_support` inliers are dropped.
+DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera& camera,
+                               const DirectionSelection& selection, double outlier_deg,
+                               int min_support);
+
+// Median of |v - pi(R_nw d_w)| (pixels) over `constraints` at the rows' poses of `keyframes`
+// (NaN if empty; d_w of a free constraint from `free_directions`); directions behind the camera
+// are skipped.
+double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
+                            const std::vector<optim::DirectionConstraint>& constraints,
+                            const std::vector<Eigen::Vector3d>& free_directions = {});
+
+const char* ToString(GlobalMappingOptions::DirectionSource source);
 
 // Eq. (2)-(3) for every keyframe n (in parallel, deterministic): the model is the scans of
 // keyframes within N frames before n, placed with the current poses; up to 9 x samples_per_list

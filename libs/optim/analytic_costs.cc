@@ -67,28 +67,55 @@ bool PointToImlsAnalyticCost::Evaluate(double const* const* parameters, double* 
 // r = s (v - pi(d)), d = +-R_wn^T d_w (flipped to z >= 0, z clamped at min_z as in the autodiff
 // functor). dr/dd = -s [fx/z 0 -fx x/z^2; 0 fy/z -fy y/z^2] (third column 0 when clamped);
 // dr/dq = dr/dd * sign * d(R^T d_w)/dq; the translation columns are exactly zero.
-bool DirectionProjectionAnalyticCost::Evaluate(double const* const* parameters, double* residuals,
-                                               double** jacobians) const {
-  const double* pose = parameters[0];
+namespace {
+
+// Shared by the fixed and the free form: residual and Jacobians w.r.t. the pose quaternion
+// (2 x 4) and the world direction (2 x 3) of r = s (v - pi(+-R_wn^T d_w)).
+bool EvaluateDirection(const PinholeCamera& camera, const Eigen::Vector2d& vp, double s,
+                       double min_z, const double* pose, const Eigen::Vector3d& d_w,
+                       double* residuals, double* jac_pose, double* jac_direction) {
   const Eigen::Map<const Eigen::Quaterniond> q_wc(pose);
-  Eigen::Vector3d d = q_wc.conjugate() * direction_world_;
+  Eigen::Vector3d d = q_wc.conjugate() * d_w;
   const double sign = d.z() < 0 ? -1.0 : 1.0;
   d *= sign;
-  const bool clamped = d.z() < min_z_;
-  if (clamped) d.z() = min_z_;
+  const bool clamped = d.z() < min_z;
+  if (clamped) d.z() = min_z;
   const double inv_z = 1.0 / d.z();
-  const double s = sqrt_information_;
-  residuals[0] = s * (vp_.x() - (camera_.fx * d.x() * inv_z + camera_.cx));
-  residuals[1] = s * (vp_.y() - (camera_.fy * d.y() * inv_z + camera_.cy));
-  if (jacobians == nullptr || jacobians[0] == nullptr) return true;
+  residuals[0] = s * (vp.x() - (camera.fx * d.x() * inv_z + camera.cx));
+  residuals[1] = s * (vp.y() - (camera.fy * d.y() * inv_z + camera.cy));
+  if (jac_pose == nullptr && jac_direction == nullptr) return true;
   Eigen::Matrix<double, 2, 3> dr_dd;
-  dr_dd << -s * camera_.fx * inv_z, 0, s * camera_.fx * d.x() * inv_z * inv_z,  //
-      0, -s * camera_.fy * inv_z, s * camera_.fy * d.y() * inv_z * inv_z;
+  dr_dd << -s * camera.fx * inv_z, 0, s * camera.fx * d.x() * inv_z * inv_z,  //
+      0, -s * camera.fy * inv_z, s * camera.fy * d.y() * inv_z * inv_z;
   if (clamped) dr_dd.col(2).setZero();
-  Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jacobians[0]);
-  j.leftCols<4>() = sign * dr_dd * InverseRotateJacobian(pose, direction_world_);
-  j.rightCols<3>().setZero();
+  if (jac_pose != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jac_pose);
+    j.leftCols<4>() = sign * dr_dd * InverseRotateJacobian(pose, d_w);
+    j.rightCols<3>().setZero();
+  }
+  if (jac_direction != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jac_direction);
+    j = sign * dr_dd * q_wc.conjugate().toRotationMatrix();
+  }
   return true;
+}
+
+}  // namespace
+
+bool DirectionProjectionAnalyticCost::Evaluate(double const* const* parameters, double* residuals,
+                                               double** jacobians) const {
+  return EvaluateDirection(camera_, vp_, sqrt_information_, min_z_, parameters[0],
+                           direction_world_, residuals,
+                           jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
+}
+
+// The direction block is kept unit by its sphere manifold; it is used as stored.
+bool DirectionProjectionFreeCost::Evaluate(double const* const* parameters, double* residuals,
+                                           double** jacobians) const {
+  const Eigen::Map<const Eigen::Vector3d> d_w(parameters[1]);
+  return EvaluateDirection(camera_, vp_, sqrt_information_, min_z_, parameters[0], d_w,
+                           residuals, jacobians != nullptr ? jacobians[0] : nullptr,
+                           jacobians != nullptr ? jacobians[1] : nullptr);
 }
 
 }  // namespace jvl::optim

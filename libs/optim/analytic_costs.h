@@ -59,4 +59,23 @@ class DirectionProjectionAnalyticCost : public ceres::SizedCostFunction<2, 7> {
   const double min_z_;
 };
 
+// e_D with d_w as a second parameter block (a free direction on the unit sphere, shared by the
+// keyframes of one direction cluster): the same residual as DirectionProjectionAnalyticCost;
+// dr/dd_w = sign * dr/dd * R_wn^T.
+class DirectionProjectionFreeCost : public ceres::SizedCostFunction<2, 7, 3> {
+ public:
+  DirectionProjectionFreeCost(const PinholeCamera& camera, const Eigen::Vector2d& vp,
+                              double sqrt_information, double min_z)
+      : camera_(camera), vp_(vp), sqrt_information_(sqrt_information), min_z_(min_z) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const PinholeCamera camera_;
+  const Eigen::Vector2d vp_;
+  const double sqrt_information_;
+  const double min_z_;
+};
+
 }  // namespace jvl::optim

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <memory>
 
 #include "optim/cost_functions.h"
@@ -107,6 +108,39 @@ TEST(DirectionProjectionAnalyticCost, MatchesAutodiffAndNumericIncludingGuards) 
       std::string log;
       EXPECT_LT(CheckGradient(analytic, {true}, {pose.data()}, &log), 1e-5) << log;
     }
+  }
+}
+
+// The free form (d_w as a parameter block) gives the fixed form's residual and pose Jacobian,
+// and its direction Jacobian matches numeric differences (plain 3-vector block: the sphere
+// manifold's PlusJacobian is applied by Ceres).
+TEST(DirectionProjectionFreeCost, MatchesTheFixedFormAndNumeric) {
+  std::mt19937 rng(8);
+  const PinholeCamera camera = KittiLikeCamera();
+  for (const Eigen::Vector3d& d_cam :
+       {Eigen::Vector3d(0.05, 0.01, 1.0), Eigen::Vector3d(-0.3, 0.1, 0.9),
+        Eigen::Vector3d(0.1, 0.0, -1.0)}) {
+    const Rigid3d world_from_cam = RandomPose(rng, 0.4, 5.0);
+    const Eigen::Vector3d d_w = world_from_cam.rotation() * d_cam.normalized();
+    const Eigen::Vector2d vp(650.0, 170.0);
+    PoseBlock pose = ToPoseBlock(world_from_cam);
+    std::array<double, 3> dir = {d_w.x(), d_w.y(), d_w.z()};
+    DirectionProjectionFreeCost free(camera, vp, 0.5, 0.05);
+    DirectionProjectionAnalyticCost fixed(camera, vp, d_w, 0.5, 0.05);
+    double r_free[2], r_fixed[2], j_pose_free[14], j_dir[6], j_pose_fixed[14];
+    double* jf[2] = {j_pose_free, j_dir};
+    double* jx[1] = {j_pose_fixed};
+    const double* pf[2] = {pose.data(), dir.data()};
+    const double* px[1] = {pose.data()};
+    ASSERT_TRUE(free.Evaluate(pf, r_free, jf));
+    ASSERT_TRUE(fixed.Evaluate(px, r_fixed, jx));
+    for (int i = 0; i < 2; ++i) EXPECT_DOUBLE_EQ(r_free[i], r_fixed[i]);
+    for (int i = 0; i < 14; ++i) EXPECT_DOUBLE_EQ(j_pose_free[i], j_pose_fixed[i]);
+    std::string log;
+    EXPECT_LT(CheckGradient(free, {true, false}, {pose.data(), dir.data()}, &log), 1e-5) << log;
+    // Translation columns are exactly zero: e_D constrains the rotation only.
+    for (int row = 0; row < 2; ++row)
+      for (int col = 4; col < 7; ++col) EXPECT_EQ(j_pose_free[row * 7 + col], 0.0);
   }
 }
 

@@ -1,6 +1,7 @@
 #include "optim/joint_problem.h"
 
 #include <ceres/loss_function.h>
+#include <ceres/sphere_manifold.h>
 
 #include <algorithm>
 #include <cmath>
@@ -50,7 +51,14 @@ void CheckResiduals(const JointProblemInput& input) {
     JVL_CHECK(d.vp.allFinite() && Finite(d.direction_world) && d.direction_world.norm() > 1e-9,
               "direction constraint of keyframe " << d.keyframe
                                                   << " has a non-finite VP or a zero direction");
+    JVL_CHECK(d.free_direction < static_cast<int32_t>(input.free_directions.size()),
+              "direction constraint of keyframe " << d.keyframe << " refers to free direction "
+                                                  << d.free_direction << " of "
+                                                  << input.free_directions.size());
   }
+  for (size_t i = 0; i < input.free_directions.size(); ++i)
+    JVL_CHECK(Finite(input.free_directions[i]) && input.free_directions[i].norm() > 1e-9,
+              "free direction " << i << " is not finite or zero");
 }
 
 void CheckInput(const JointProblemInput& input) {
@@ -118,6 +126,12 @@ void AddDirections(const JointProblemInput& input, const JointProblemOptions& op
   for (const DirectionConstraint& d : input.directions) {
     double* pose = jp.poses.at(d.keyframe).data();
     const double min_z = options.direction_min_z;
+    if (d.free_direction >= 0) {
+      jp.direction_blocks.push_back(jp.problem->AddResidualBlock(
+          new DirectionProjectionFreeCost(input.camera, d.vp, sqrt_info, min_z), loss, pose,
+          jp.free_directions[static_cast<size_t>(d.free_direction)].data()));
+      continue;
+    }
     ceres::CostFunction* cost =
         options.analytic_jacobians
             ? static_cast<ceres::CostFunction*>(new DirectionProjectionAnalyticCost(
@@ -164,6 +178,11 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
   for (const auto& [id, pose] : input.poses) jp.poses[id] = ToPoseBlock(pose);
   jp.map_points.reserve(input.map_points.size());  // addresses must stay stable
   for (const Eigen::Vector3d& p : input.map_points) jp.map_points.push_back({p.x(), p.y(), p.z()});
+  jp.free_directions.reserve(input.free_directions.size());
+  for (const Eigen::Vector3d& d : input.free_directions) {
+    const Eigen::Vector3d u = d.normalized();
+    jp.free_directions.push_back({u.x(), u.y(), u.z()});
+  }
 
   ceres::Problem::Options problem_options;
   problem_options.enable_fast_removal = false;
@@ -172,6 +191,10 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
   ceres::Manifold* manifold = MakePoseManifold().release();
   for (auto& [id, block] : jp.poses) {
     jp.problem->AddParameterBlock(block.data(), kPoseBlockSize, manifold);
+  }
+  if (!jp.free_directions.empty()) {
+    ceres::Manifold* sphere = new ceres::SphereManifold<3>();
+    for (auto& d : jp.free_directions) jp.problem->AddParameterBlock(d.data(), 3, sphere);
   }
   // Counts for the weight rule are taken from the inputs (before dropping invalid observations).
   jp.weights = ResolveWeights(options, static_cast<int64_t>(input.observations.size()),

@@ -45,7 +45,10 @@ struct ImlsCorrespondence {
 struct DirectionConstraint {
   int64_t keyframe = 0;
   Eigen::Vector2d vp = Eigen::Vector2d::Zero();  // pixels, finite
-  Eigen::Vector3d direction_world = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d direction_world = Eigen::Vector3d::UnitZ();  // used if free_direction < 0
+  // >= 0: d_w is JointProblemInput::free_directions[free_direction], a unit-sphere parameter
+  // block optimised with the poses (shared by the constraints of one direction cluster).
+  int32_t free_direction = -1;
 };
 
 struct JointProblemInput {
@@ -56,6 +59,7 @@ struct JointProblemInput {
   std::vector<VisualObservation> observations;
   std::vector<ImlsCorrespondence> imls;
   std::vector<DirectionConstraint> directions;
+  std::vector<Eigen::Vector3d> free_directions;  // initial values of the free d_w blocks
 };
 
 struct JointProblemOptions {
@@ -96,6 +100,7 @@ JointWeights ResolveWeights(const JointProblemOptions& options, int64_t num_visu
 struct JointProblem {
   std::map<int64_t, PoseBlock> poses;
   std::vector<std::array<double, 3>> map_points;
+  std::vector<std::array<double, 3>> free_directions;
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks;
   std::set<int64_t> fixed;  // effective constant poses (gauge)
@@ -140,6 +145,7 @@ struct JointSolveResult {
   std::string linear_solver;
   std::map<int64_t, Rigid3d> poses;         // optimised world_from_cam
   std::vector<Eigen::Vector3d> map_points;  // optimised (unchanged if not optimised)
+  std::vector<Eigen::Vector3d> free_directions;  // optimised free d_w blocks (unit)
 };
 
 JointCostBreakdown EvaluateJointCost(JointProblem& problem, int threads);

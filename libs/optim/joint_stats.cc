@@ -57,6 +57,7 @@ ceres::Solver::Options MakeSolverOptions(JointProblem& jp, const SolveOptions& o
     if (jp.problem->HasParameterBlock(point.data())) ordering->AddElementToGroup(point.data(), 0);
   }
   for (auto& [id, block] : jp.poses) ordering->AddElementToGroup(block.data(), 1);
+  for (auto& d : jp.free_directions) ordering->AddElementToGroup(d.data(), 1);
   so.linear_solver_ordering = ordering;
   return so;
 }
@@ -103,6 +104,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   for (const auto& [id, block] : jp.poses) result.poses[id] = FromPoseBlock(block);
   result.map_points.reserve(jp.map_points.size());
   for (const auto& p : jp.map_points) result.map_points.emplace_back(p[0], p[1], p[2]);
+  for (const auto& d : jp.free_directions) result.free_directions.emplace_back(d[0], d[1], d[2]);
   result.time_s = timer.ElapsedSeconds();
   return result;
 }

@@ -52,6 +52,23 @@ int main(int argc, char** argv) {
   cli.add_option("--first-direction-round", o.first_direction_round,
                  "Rounds before this one run without e_D (warm start; 0 = e_D in every round)")
       ->capture_default_str();
+  std::string direction_source = "free";
+  cli.add_option("--direction-source", direction_source,
+                 "d_w of e_D: 'free' re-estimates each cluster's direction from the rotations "
+                 "after the warm-start round (robust mean, outlier VPs dropped) and optimises it "
+                 "with the poses; 'refit' keeps that re-estimate fixed; 'prior' uses "
+                 "direction_cluster's d_w as is (the paper)")
+      ->check(CLI::IsMember({"free", "refit", "prior"}))
+      ->capture_default_str();
+  cli.add_option("--refit-outlier-deg", o.refit_outlier_deg,
+                 "refit/free: smallest gate (deg) for VPs far from their cluster's direction")
+      ->capture_default_str();
+  cli.add_option("--direction-sigma", o.direction_sigma_px,
+                 "sigma of e_D in pixels (<= 0: estimated from the VP residuals when e_D enters)")
+      ->capture_default_str();
+  cli.add_option("--direction-huber", o.joint.direction_huber,
+                 "Huber threshold of e_D in sigmas (<= 0: none)")
+      ->capture_default_str();
   cli.add_flag("!--fixed-map-points", o.joint.optimize_map_points,
                "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only)");
   cli.add_option("--map", map_path, "Accumulated map PLY (stored scans, optimised poses)");
@@ -59,6 +76,10 @@ int main(int argc, char** argv) {
   cli.add_flag("--map-ascii", map_ascii, "Write the PLY as ASCII instead of binary");
   return tool.Run(argc, argv, [&] {
     o.use_directions = !no_direction;
+    using Source = mapping::GlobalMappingOptions::DirectionSource;
+    o.direction_source = direction_source == "prior"   ? Source::kPrior
+                         : direction_source == "refit" ? Source::kRefit
+                                                       : Source::kFree;
     o.use_saved_imls = !no_saved;
     o.fresh_traversal = !no_fresh;
     o.solve.threads = tool.threads();
@@ -100,12 +121,14 @@ int main(int argc, char** argv) {
     const auto& s = result.solve;
     spdlog::info(
         "{} keyframes, {} frames: {} visual, {} IMLS ({} saved + {} fresh), {} direction "
-        "residuals ({} skipped: not keyframes, {} at infinity); weights alpha {:.3g} beta {:.3g} "
+        "residuals ({} skipped: not keyframes, {} at infinity, {} refit outliers; sigma {:.2f} "
+        "px); weights alpha {:.3g} beta {:.3g} "
         "gamma {:.3g}; cost {:.6g} -> {:.6g}; {} rounds, {} iterations ({:.2f} s IMLS "
         "traversal, {:.2f} s total)",
         result.keyframes.size(), out.trajectory.size(), s.before.visual.count, s.before.imls.count,
-        result.saved_imls, result.fresh_imls, s.before.direction.count,
-        result.directions_not_keyframe, result.directions_at_infinity, s.weights.alpha,
+        result.saved_imls, result.fresh_imls, result.directions_used,
+        result.directions_not_keyframe, result.directions_at_infinity,
+        result.directions_outliers, result.direction_sigma_px, s.weights.alpha,
         s.weights.beta, s.weights.gamma, s.before.total, s.after.total, result.rounds,
         result.total_iterations, result.traversal_time_s, result.total_time_s);
   });
