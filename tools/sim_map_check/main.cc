@@ -70,8 +70,7 @@ int main(int argc, char** argv) {
     }
     PrintStats("all", s.all);
     if (!csv_path.empty()) {
-      jvl::io::WriteTextFileAtomic(csv_path,
-                                   jvl::tools::FormatPointsCsv(result, world->scene, visual));
+      jvl::io::WriteTextFileAtomic(csv_path, jvl::tools::FormatPointsCsv(result, *world, visual));
     }
     if (!json_path.empty()) {
       jvl::io::WriteJsonArtifact(json_path, "sim_map_check", 1, jvl::tools::ToJson(result),

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "core/check.h"
 #include "io/artifact.h"
@@ -157,8 +158,59 @@ nlohmann::json ToJson(const MapCheckRunResult& result) {
   return j;
 }
 
-std::string FormatPointsCsv(const MapCheckRunResult& result, const sim::Scene& scene,
+std::vector<double> KeypointConsistency(const sim::World& world, const io::VisualMapData& visual,
+                                        const std::vector<sim::PointView>& views) {
+  const size_t m = visual.num_mappoints();
+  std::vector<std::vector<size_t>> observations(m);
+  for (size_t o = 0; o < visual.num_observations(); ++o) {
+    observations[static_cast<size_t>(visual.observation_mappoint[o])].push_back(o);
+  }
+  std::vector<Rigid3d> map_from_cam;
+  for (const Rigid3d& pose : visual.keyframes.world_from_cam) {
+    map_from_cam.push_back(world.map_from_world * pose);
+  }
+  const auto uv = [&](size_t keypoint) {
+    return Eigen::Vector2d(visual.keypoint_uv[2 * keypoint], visual.keypoint_uv[2 * keypoint + 1]);
+  };
+  std::vector<double> out(m, std::numeric_limits<double>::quiet_NaN());
+  for (size_t p = 0; p < m && p < views.size(); ++p) {
+    const int k = views[p].keyframe;
+    const auto& obs = observations[p];
+    const auto nearest = std::find_if(
+        obs.begin(), obs.end(), [&](size_t o) { return visual.observation_keyframe[o] == k; });
+    if (nearest == obs.end()) continue;
+    // The true surface point behind the nearest keypoint.
+    const Rigid3d& pose = map_from_cam[static_cast<size_t>(k)];
+    const Eigen::Vector3d dir =
+        (pose.RotationMatrix() *
+         visual.camera.Unproject(uv(static_cast<size_t>(visual.observation_keypoint[*nearest]))))
+            .normalized();
+    sim::Hit hit = world.caster->Intersect(pose.translation(), dir, 1e-3, 1e4);
+    std::vector<sim::Box> cars;
+    for (size_t c = 0; c < world.scene.moving_cars.size(); ++c) {
+      cars.push_back(world.scene.MovingCarBox(c, views[p].time));
+    }
+    sim::IntersectBoxes(cars, pose.translation(), dir, &hit);
+    if (!hit.valid()) continue;
+    const Eigen::Vector3d y = pose.translation() + hit.t * dir;
+    double worst = 0;
+    for (size_t o : observations[p]) {
+      const size_t q = static_cast<size_t>(visual.observation_keypoint[o]);
+      const Eigen::Vector3d c =
+          map_from_cam[static_cast<size_t>(visual.observation_keyframe[o])].Inverse() * y;
+      const double sigma = std::pow(visual.scale_factor, visual.keypoint_octave[q]);
+      worst = c.z() > 0 ? std::max(worst, (visual.camera.Project(c) - uv(q)).norm() / sigma)
+                        : std::numeric_limits<double>::infinity();
+      if (c.z() <= 0) break;
+    }
+    out[p] = worst;
+  }
+  return out;
+}
+
+std::string FormatPointsCsv(const MapCheckRunResult& result, const sim::World& world,
                             const io::VisualMapData& visual) {
+  const std::vector<double> consistency = KeypointConsistency(world, visual, result.views);
   std::vector<int> observations(visual.num_mappoints(), 0);
   std::vector<std::vector<Eigen::Vector3d>> rays(visual.num_mappoints());
   for (size_t o = 0; o < visual.observation_mappoint.size(); ++o) {
@@ -173,22 +225,25 @@ std::string FormatPointsCsv(const MapCheckRunResult& result, const sim::Scene& s
   }
   std::string out =
       "point,x,y,z,frame,depth,hit,surface,along_ray,perpendicular,cos_incidence,observations,"
-      "parallax_deg\n";
-  char line[320];
+      "parallax_deg,keypoint_error_sigma\n";
+  char line[360];
   for (size_t p = 0; p < result.distances.size(); ++p) {
     const sim::SurfaceDistance& d = result.distances[p];
     const sim::PointView& v = result.views[p];
     const char* surface =
-        !d.hit         ? "none"
-        : d.moving_car ? "moving_car"
-                       : sim::ToString(scene.mesh.faces[static_cast<size_t>(d.face)].material);
+        !d.hit ? "none"
+        : d.moving_car
+            ? "moving_car"
+            : sim::ToString(world.scene.mesh.faces[static_cast<size_t>(d.face)].material);
     const int64_t frame =
         v.keyframe >= 0 ? visual.keyframes.frames[static_cast<size_t>(v.keyframe)] : -1;
-    std::snprintf(line, sizeof(line), "%zu,%.4f,%.4f,%.4f,%lld,%.3f,%d,%s,%.4f,%.4f,%.4f,%d,%.3f\n",
-                  p, visual.mappoint_position[3 * p], visual.mappoint_position[3 * p + 1],
+    std::snprintf(line, sizeof(line),
+                  "%zu,%.4f,%.4f,%.4f,%lld,%.3f,%d,%s,%.4f,%.4f,%.4f,%d,%.3f,%.3f\n", p,
+                  visual.mappoint_position[3 * p], visual.mappoint_position[3 * p + 1],
                   visual.mappoint_position[3 * p + 2], static_cast<long long>(frame),
                   std::isfinite(d.depth) ? d.depth : -1.0, d.hit ? 1 : 0, surface, d.along_ray,
-                  d.perpendicular, d.cos_incidence, observations[p], Parallax(rays[p]));
+                  d.perpendicular, d.cos_incidence, observations[p], Parallax(rays[p]),
+                  std::isfinite(consistency[p]) ? consistency[p] : -1.0);
     out += line;
   }
   return out;

@@ -44,11 +44,20 @@ MapCheckRunResult RunMapCheck(const sim::World& world, const io::VisualMapData& 
 
 nlohmann::json ToJson(const MapCheckRunResult& result);
 
+// Per map point: how well its observations agree with one true surface point. The point seen
+// behind its keypoint in the nearest keyframe (ray cast) is projected into every observing
+// keyframe; the result is the largest distance to the observing keypoint in units of that
+// keypoint's sigma (scale^octave px). NaN when that ray hits nothing, +inf when the surface point
+// is behind an observing camera.
+std::vector<double> KeypointConsistency(const sim::World& world, const io::VisualMapData& visual,
+                                        const std::vector<sim::PointView>& views);
+
 // One line per map point: "point,x,y,z,frame,depth,hit,surface,along_ray,perpendicular,
-// cos_incidence,observations,parallax_deg" (x, y, z in the pose world frame; frame: the keyframe
-// measured from, -1 for none; surface: the material hit, moving_car or none; parallax: the largest
-// angle between two of the point's viewing rays).
-std::string FormatPointsCsv(const MapCheckRunResult& result, const sim::Scene& scene,
+// cos_incidence,observations,parallax_deg,keypoint_error_sigma" (x, y, z in the pose world
+// frame; frame: the keyframe measured from, -1 for none; surface: the material hit, moving_car
+// or none; parallax: the largest angle between two of the point's viewing rays;
+// keypoint_error_sigma: KeypointConsistency, -1 when not finite).
+std::string FormatPointsCsv(const MapCheckRunResult& result, const sim::World& world,
                             const io::VisualMapData& visual);
 
 }  // namespace jvl::tools

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "core/timer.h"
@@ -125,6 +126,12 @@ TEST_F(SimMapCheckTest, GroundTruthPriorMapNearTheSurface) {
   EXPECT_GT(all.within_threshold, 0.15);
   ASSERT_EQ(r.summary.bins.size(), 3u);
   for (const auto& b : r.summary.bins) EXPECT_GT(b.points, 100);
+  // Most points' observations agree with one true surface point (within 3 sigma).
+  const std::vector<double> consistency = KeypointConsistency(*world_, *visual_, r.views);
+  ASSERT_EQ(consistency.size(), visual_->num_mappoints());
+  const auto agree =
+      std::count_if(consistency.begin(), consistency.end(), [](double e) { return e < 3; });
+  EXPECT_GT(agree, static_cast<std::ptrdiff_t>(consistency.size() / 2));
   // Moving the real points 0.3 m along their rays makes the figure clearly worse.
   const MapCheckRunResult m =
       RunMapCheck(*world_, MoveAlongRays(*visual_, r, *world_, false, 0.3), options, 2);
@@ -135,7 +142,8 @@ TEST_F(SimMapCheckTest, CommandLine) {
   const std::string exe = std::string(JVL_BINARY_DIR) + "/bin/sim_map_check";
   if (!io::FileExists(exe)) GTEST_SKIP() << exe << " not built";
   const std::string cmd = exe + " --sequence " + SequenceDir() + " --visual " + Path("visual.h5") +
-                          " --json " + Path("report.json") + " --threads 2 --quiet";
+                          " --json " + Path("report.json") + " --points-csv " + Path("points.csv") +
+                          " --threads 2 --quiet";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const nlohmann::json report = io::ReadJsonArtifact(Path("report.json"), "sim_map_check", 1);
   EXPECT_TRUE(io::CheckJsonAgainstSchema(
@@ -146,6 +154,9 @@ TEST_F(SimMapCheckTest, CommandLine) {
   EXPECT_EQ(report["all"]["median_perpendicular_m"].get<double>(),
             r.summary.all.median_perpendicular);
   EXPECT_EQ(report["depth_bins"].size(), 3u);
+  const std::string csv = io::ReadTextFile(Path("points.csv"));
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'),
+            static_cast<std::ptrdiff_t>(visual_->num_mappoints() + 1));
   // Bad input: one error line, non-zero exit.
   EXPECT_NE(std::system((exe + " --sequence " + Path("nowhere") + " --visual " + Path("visual.h5") +
                          " 2>/dev/null")
