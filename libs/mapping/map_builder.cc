@@ -137,8 +137,7 @@ FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_
     const int k = static_cast<int>(map_.keyframes.size()) - 1;
     for (size_t i = 0; i < keypoint_point.size(); ++i) {
       if (keypoint_point[i] < 0) continue;
-      if (!AlignKeypoint(keypoint_point[i], k, static_cast<int>(i)) &&
-          options_.require_alignment) {
+      if (!AlignKeypoint(keypoint_point[i], k, static_cast<int>(i)) && options_.require_alignment) {
         continue;
       }
       AddObservation(&map_, keypoint_point[i], k, static_cast<int>(i));

@@ -158,9 +158,8 @@ bool VisualMapBuilder::AlignKeypoint(int point, int keyframe, int keypoint) {
   const Keyframe& ref = map_.keyframes[p.patch_keyframe];
   const double d_ref = (p.position - ref.world_from_cam.translation()).norm();
   const double d = (p.position - kf.world_from_cam.translation()).norm();
-  const double scale = std::clamp(d_ref * map_.level_scales[p.patch_octave] /
-                                      (d * map_.level_scales[kp.octave]),
-                                  0.7, 1.4);
+  const double scale = std::clamp(
+      d_ref * map_.level_scales[p.patch_octave] / (d * map_.level_scales[kp.octave]), 0.7, 1.4);
   const vision::PatchAlignment a = vision::AlignPatch(
       level, p.patch, vision::ImageToLevel(kp.uv.cast<double>(), level.size(), image), scale,
       options_.align);

@@ -70,7 +70,6 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
   Eigen::Vector2d c = start;
   double a = 1, b = 0;
   std::array<float, n> current{};
-  // Initial brightness: match means and spreads.
   for (int it = 0; it <= options.iterations; ++it) {
     Eigen::Matrix4d h = Eigen::Matrix4d::Zero();
     Eigen::Vector4d g = Eigen::Vector4d::Zero();

@@ -1,7 +1,6 @@
 #include "map_check_run.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -195,18 +194,6 @@ std::vector<double> KeypointConsistency(const sim::World& world, const io::Visua
     if (!hit.valid()) continue;
     const Eigen::Vector3d y = pose.translation() + hit.t * dir;
     double worst = 0;
-    static FILE* dump = std::getenv("JVL_OBS_DUMP") ? std::fopen(std::getenv("JVL_OBS_DUMP"), "w") : nullptr;
-    if (dump) {
-      const size_t q0 = static_cast<size_t>(visual.observation_keypoint[*nearest]);
-      for (size_t o : observations[p]) {
-        const size_t q = static_cast<size_t>(visual.observation_keypoint[o]);
-        const Eigen::Vector3d c =
-            map_from_cam[static_cast<size_t>(visual.observation_keyframe[o])].Inverse() * y;
-        if (c.z() <= 0) continue;
-        const Eigen::Vector2d pr = visual.camera.Project(c);
-        std::fprintf(dump, "%zu,%d,%d,%d,%.3f,%.3f,%.4f,%.4f,%.3f\n", p, visual.observation_keyframe[o], visual.keypoint_octave[q], visual.keypoint_octave[q0], pr.x(), pr.y(), uv(q).x() - pr.x(), uv(q).y() - pr.y(), c.z());
-      }
-    }
     for (size_t o : observations[p]) {
       const size_t q = static_cast<size_t>(visual.observation_keypoint[o]);
       const Eigen::Vector3d c =
