@@ -23,6 +23,7 @@ void VisualMapOptions::Check() const {
   JVL_CHECK(cull_after_keyframes >= 1, "visual map: cull_after_keyframes must be >= 1");
   JVL_CHECK(min_found_ratio >= 0 && min_found_ratio <= 1, "visual map: min_found_ratio in [0, 1]");
   JVL_CHECK(max_final_chi2 > 0, "visual map: max_final_chi2 must be > 0");
+  JVL_CHECK(track_chi2 >= 0, "visual map: track_chi2 must be >= 0");
   JVL_CHECK(min_covisibility_weight >= 1, "visual map: min_covisibility_weight must be >= 1");
 }
 
@@ -64,6 +65,14 @@ std::vector<int> VisualMapBuilder::Track(const vision::OrbFeatures& features,
     MapPoint& p = map_.points[predicted[i]];
     ++p.visible;
     if (match[i] < 0) continue;
+    if (options_.track_chi2 > 0) {
+      const vision::OrbKeypoint& kp = features.keypoints[match[i]];
+      const double s = map_.level_scales[kp.octave];
+      if (vision::SquaredReprojectionError(map_.camera, cam_from_world, p.position,
+                                           kp.uv.cast<double>()) > options_.track_chi2 * s * s) {
+        continue;
+      }
+    }
     ++p.found;
     keypoint_point[match[i]] = predicted[i];
     ++report->tracked;
@@ -128,8 +137,15 @@ FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_
     const int k = static_cast<int>(map_.keyframes.size()) - 1;
     for (size_t i = 0; i < keypoint_point.size(); ++i) {
       if (keypoint_point[i] < 0) continue;
+      if (!AlignKeypoint(keypoint_point[i], k, static_cast<int>(i)) && options_.require_alignment) {
+        continue;
+      }
       AddObservation(&map_, keypoint_point[i], k, static_cast<int>(i));
-      UpdatePointGeometry(&map_, keypoint_point[i]);
+      if (options_.refine_on_insert) {
+        RefineAndCheck(keypoint_point[i]);
+      } else {
+        UpdatePointGeometry(&map_, keypoint_point[i]);
+      }
     }
     const size_t before = map_.points.size();
     report.new_points = CreateNewPoints(k);
@@ -137,6 +153,9 @@ FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_
     for (size_t p = before; p < map_.points.size(); ++p) created.push_back(static_cast<int>(p));
     report.fused = FusePoints(k, created);
     report.culled = CullRecentPoints(k);
+    // Only the local keyframes receive observations; older pyramids are not needed.
+    const int old = k - options_.local_keyframes - 1;
+    if (old >= 0) map_.keyframes[old].features.pyramid.clear();
     frames_since_keyframe_ = 0;
   }
   last_frame_ = frame;
@@ -145,6 +164,7 @@ FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_
 }
 
 VisualMap VisualMapBuilder::Finish() {
+  for (Keyframe& kf : map_.keyframes) kf.features.pyramid.clear();
   for (size_t i = 0; i < map_.points.size(); ++i) {
     MapPoint& p = map_.points[i];
     if (p.bad) continue;
@@ -187,6 +207,8 @@ VisualMapResult BuildVisualMap(const PinholeCamera& camera, const Trajectory& po
                                const std::function<void(const FrameReport&)>& on_frame) {
   options.Check();
   poses.Check("prior poses");
+  vision::OrbOptions orb = options.orb;
+  orb.keep_pyramid = options.align_patches;
   std::vector<int64_t> directions = direction_frames;
   std::sort(directions.begin(), directions.end());
   VisualMapResult result;
@@ -202,7 +224,7 @@ VisualMapResult BuildVisualMap(const PinholeCamera& camera, const Trajectory& po
       const Timer t;
       const cv::Mat image = load_image(poses.frames[start + i]);
       sizes[i] = image.size();
-      features[i] = vision::ExtractOrb(image, options.orb);
+      features[i] = vision::ExtractOrb(image, orb);
       ms[i] = t.ElapsedMs();
     });
     for (int64_t i = 0; i < m; ++i) {

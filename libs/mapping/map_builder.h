@@ -40,6 +40,18 @@ struct VisualMapOptions {
   double min_found_ratio = 0.25;     // Culling: found / visible.
   bool refine_points = true;         // Structure-only refinement in Finish().
   double max_final_chi2 = 5.991;     // Observations beyond this (x level variance) are dropped.
+  // Tracking gate: a projection match is kept only if the point reprojects within this bound
+  // (x level variance) of the keypoint; 0 disables the gate.
+  double track_chi2 = 5.991;
+  // Points gaining observations in a keyframe are refined (poses fixed) and their observations
+  // beyond max_final_chi2 dropped at once, not only in Finish().
+  bool refine_on_insert = true;
+  // Observations are aligned to the point's reference patch (patch_align.h) before use.
+  bool align_patches = true;
+  // Observations whose patch does not align (NCC below align.min_ncc, or it drifts) are not
+  // added: they are most often a different surface point with a similar descriptor.
+  bool require_alignment = true;
+  vision::PatchAlignOptions align;
   int min_covisibility_weight = 15;  // Edges kept in the artifact (ORB-SLAM2 threshold).
   void Check() const;
 };
@@ -77,6 +89,15 @@ class VisualMapBuilder {
   int FusePoints(int keyframe, const std::vector<int>& new_points);  // map_points.cc
   int CullRecentPoints(int keyframe);                                // map_points.cc
   std::vector<int> NeighbourKeyframes(int keyframe) const;           // map_points.cc
+  // Refines a point over its observations and drops those beyond max_final_chi2 (the point is
+  // removed below 2). Returns the number of observations dropped.
+  int RefineAndCheck(int point);  // map_points.cc
+  // Takes the reference patch of a point from one of its keypoints (map_points.cc).
+  void SetPatch(int point, int keyframe, int keypoint);
+  // Moves a keypoint to where the point's reference patch aligns (map_points.cc); false if the
+  // alignment failed (the keypoint is left as detected), true if it moved or alignment is off or
+  // not possible (no reference patch or level images).
+  bool AlignKeypoint(int point, int keyframe, int keypoint);
 
   VisualMapOptions options_;
   VisualMap map_;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <random>
 
 #include "core/check.h"
@@ -120,10 +121,15 @@ TEST(VisualMapBuilder, SyntheticCorridorWithKnownPoses) {
       error_near.push_back((p.position - scene.point(ids.front())).norm());
     }
   }
+  std::sort(error_near.begin(), error_near.end());
+  std::printf("corridor: %d points, %d inconsistent, %zu within 30 m, median error %.3f m\n", good,
+              wrong, error_near.size(),
+              error_near.empty() ? 0.0 : error_near[error_near.size() / 2]);
   ASSERT_GT(good, 1000);
   EXPECT_LT(wrong, 0.02 * good);
-  std::sort(error_near.begin(), error_near.end());
-  ASSERT_GT(error_near.size(), 500u);
+  // Tracking matches are gated by their reprojection and points lose outlying observations as
+  // they are refined, so fewer near points survive than without those checks (446 vs > 500).
+  ASSERT_GT(error_near.size(), 400u);
   // Median 3D error within 30 m; keypoint noise is 0.3 px x level scale (up to 1.1 px).
   EXPECT_LT(error_near[error_near.size() / 2], 0.10);
 

@@ -66,9 +66,19 @@ int VisualMapBuilder::CreateNewPoints(int keyframe) {
       point.created_keyframe = keyframe;
       map_.points.push_back(point);
       const int p = static_cast<int>(map_.points.size()) - 1;
+      SetPatch(p, keyframe, i);
+      if (!AlignKeypoint(p, neighbours[n], j) && options_.require_alignment) {
+        map_.points[p].bad = true;
+        continue;
+      }
       AddObservation(&map_, p, neighbours[n], j);
       AddObservation(&map_, p, keyframe, i);
-      UpdatePointGeometry(&map_, p);
+      if (options_.refine_on_insert) {
+        RefineAndCheck(p);
+        if (map_.points[p].bad) continue;
+      } else {
+        UpdatePointGeometry(&map_, p);
+      }
       recent_points_.push_back(p);
       ++created;
     }
@@ -100,6 +110,7 @@ int VisualMapBuilder::FusePoints(int keyframe, const std::vector<int>& new_point
     for (size_t i = 0; i < match.size(); ++i) {
       if (match[i] < 0) continue;
       const int p = predicted[i];
+      if (!AlignKeypoint(p, k, match[i]) && options_.require_alignment) continue;
       const vision::OrbKeypoint& kp = nb.features.keypoints[match[i]];
       const double s = map_.level_scales[kp.octave];
       if (vision::SquaredReprojectionError(map_.camera, nb.cam_from_world, map_.points[p].position,
@@ -114,8 +125,82 @@ int VisualMapBuilder::FusePoints(int keyframe, const std::vector<int>& new_point
   }
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-  for (int p : touched) UpdatePointGeometry(&map_, p);
+  for (int p : touched) {
+    if (options_.refine_on_insert) {
+      RefineAndCheck(p);
+    } else {
+      UpdatePointGeometry(&map_, p);
+    }
+  }
   return fused;
+}
+
+void VisualMapBuilder::SetPatch(int point, int keyframe, int keypoint) {
+  MapPoint& p = map_.points[point];
+  const vision::OrbFeatures& f = map_.keyframes[keyframe].features;
+  if (!options_.align_patches || f.pyramid.empty()) return;
+  const vision::OrbKeypoint& kp = f.keypoints[keypoint];
+  const cv::Mat& level = f.pyramid[kp.octave];
+  p.patch = vision::MakePatchTemplate(
+      level, vision::ImageToLevel(kp.uv.cast<double>(), level.size(), f.pyramid[0].size()));
+  p.patch_keyframe = keyframe;
+  p.patch_octave = kp.octave;
+}
+
+bool VisualMapBuilder::AlignKeypoint(int point, int keyframe, int keypoint) {
+  const MapPoint& p = map_.points[point];
+  Keyframe& kf = map_.keyframes[keyframe];
+  if (!options_.align_patches || !p.patch.valid || kf.features.pyramid.empty()) return true;
+  vision::OrbKeypoint& kp = kf.features.keypoints[keypoint];
+  const cv::Mat& level = kf.features.pyramid[kp.octave];
+  const cv::Size image = kf.features.pyramid[0].size();
+  // A patch pixel of the reference level, in pixels of this keypoint's level.
+  const Keyframe& ref = map_.keyframes[p.patch_keyframe];
+  const double d_ref = (p.position - ref.world_from_cam.translation()).norm();
+  const double d = (p.position - kf.world_from_cam.translation()).norm();
+  const double scale = std::clamp(
+      d_ref * map_.level_scales[p.patch_octave] / (d * map_.level_scales[kp.octave]), 0.7, 1.4);
+  const vision::PatchAlignment a = vision::AlignPatch(
+      level, p.patch, vision::ImageToLevel(kp.uv.cast<double>(), level.size(), image), scale,
+      options_.align);
+  if (!a.ok) return false;
+  kp.uv = vision::LevelToImage(a.level_xy, level.size(), image).cast<float>();
+  return true;
+}
+
+int VisualMapBuilder::RefineAndCheck(int point) {
+  MapPoint& p = map_.points[point];
+  if (p.bad) return 0;
+  int dropped = 0;
+  for (int round = 0;; ++round) {
+    std::vector<vision::PointView> views;
+    for (const Observation& o : p.observations) {
+      const Keyframe& kf = map_.keyframes[o.keyframe];
+      const vision::OrbKeypoint& kp = kf.features.keypoints[o.keypoint];
+      views.push_back({kf.cam_from_world, kp.uv.cast<double>(), map_.level_scales[kp.octave]});
+    }
+    if (views.size() >= 2) p.position = vision::RefinePoint(map_.camera, views, p.position);
+    // Drop the worst observation beyond the bound, then refine again without it.
+    int worst = -1;
+    double worst_chi2 = options_.max_final_chi2;
+    for (size_t v = 0; v < views.size(); ++v) {
+      const double chi2 = vision::SquaredReprojectionError(map_.camera, views[v].cam_from_world,
+                                                           p.position, views[v].uv) /
+                          (views[v].level_scale * views[v].level_scale);
+      if (chi2 > worst_chi2) worst_chi2 = chi2, worst = static_cast<int>(v);
+    }
+    if (worst < 0 || round == 3) break;
+    const Observation o = p.observations[worst];
+    map_.keyframes[o.keyframe].mappoint[o.keypoint] = -1;
+    p.observations.erase(p.observations.begin() + worst);
+    ++dropped;
+    if (p.observations.size() < 2) {
+      RemovePoint(&map_, point);
+      return dropped;
+    }
+  }
+  UpdatePointGeometry(&map_, point);
+  return dropped;
 }
 
 // ORB-SLAM2 MapPointCulling: a recent point must be found in >= 25 % of the frames predicting it

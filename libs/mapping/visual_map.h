@@ -13,6 +13,7 @@
 #include "io/visual_io.h"
 #include "vision/guided_matching.h"
 #include "vision/orb_features.h"
+#include "vision/patch_align.h"
 
 namespace jvl::mapping {
 
@@ -30,6 +31,9 @@ struct MapPoint {
   std::vector<Observation> observations;              // Ordered by keyframe.
   int created_keyframe = -1;
   int visible = 1, found = 1;  // Times predicted inside a frame / matched there (culling).
+  // Reference patch (from the creating keyframe) that later observations are aligned to.
+  vision::PatchTemplate patch;
+  int patch_keyframe = -1, patch_octave = 0;
   bool bad = false;
 };
 

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
+#include "vision/patch_align.h"
 
 namespace jvl::vision {
 namespace {
@@ -150,6 +151,8 @@ OrbFeatures ExtractOrb(const cv::Mat& image, const OrbOptions& options) {
   // Same pyramid as cv::ORB builds (each level resized from the previous one), so that the
   // descriptors computed below sample the level the corner was found on.
   std::vector<cv::KeyPoint> all;
+  std::vector<cv::Size> sizes;
+  OrbFeatures out;
   cv::Mat level = gray;
   for (int l = 0; l < options.num_levels; ++l) {
     if (l > 0) {
@@ -158,11 +161,13 @@ OrbFeatures ExtractOrb(const cv::Mat& image, const OrbOptions& options) {
       cv::resize(level, next, size, 0, 0, cv::INTER_LINEAR);
       level = next;
     }
+    if (options.keep_pyramid) out.pyramid.push_back(level);
+    sizes.push_back(level.size());
     for (cv::KeyPoint& kp : DetectLevel(level, wanted[l], options)) {
       kp.angle = IntensityCentroidAngle(level, cvRound(kp.pt.x), cvRound(kp.pt.y));
       kp.octave = l;
       kp.size = static_cast<float>(31 * scales[l]);
-      kp.pt *= static_cast<float>(scales[l]);
+      kp.pt *= static_cast<float>(scales[l]);  // As cv::ORB expects.
       all.push_back(kp);
     }
   }
@@ -172,12 +177,16 @@ OrbFeatures ExtractOrb(const cv::Mat& image, const OrbOptions& options) {
                              cv::ORB::HARRIS_SCORE, 2 * kHalfPatch + 1, options.fast_threshold);
   cv::Mat desc;
   orb->compute(gray, all, desc);  // May drop corners near the border; keeps the rest in order.
-  OrbFeatures out;
   out.keypoints.reserve(all.size());
   out.descriptors.resize(all.size());
   for (size_t i = 0; i < all.size(); ++i) {
-    out.keypoints.push_back(
-        {Eigen::Vector2f(all[i].pt.x, all[i].pt.y), all[i].octave, all[i].angle, all[i].response});
+    // cv::ORB's convention (level pixel x scale) back to the level pixel, then to level-0
+    // coordinates through the resizing.
+    const int o = all[i].octave;
+    const Eigen::Vector2d level_xy(std::round(all[i].pt.x / scales[o]),
+                                   std::round(all[i].pt.y / scales[o]));
+    const Eigen::Vector2f uv = LevelToImage(level_xy, sizes[o], gray.size()).cast<float>();
+    out.keypoints.push_back({uv, o, all[i].angle, all[i].response});
     std::copy(desc.ptr<uint8_t>(static_cast<int>(i)), desc.ptr<uint8_t>(static_cast<int>(i)) + 32,
               out.descriptors[i].begin());
   }

@@ -25,11 +25,14 @@ struct OrbOptions {
   int fast_min_threshold = 7;  // Retried in cells where the first threshold finds nothing.
   int cell_size = 30;          // Grid cell size in pixels of each level.
   int edge_threshold = 19;     // Border (level pixels) without features (BRIEF patch 31).
+  bool keep_pyramid = false;   // Return the pyramid levels (for patch alignment).
   void Check() const;
 };
 
 struct OrbKeypoint {
-  Eigen::Vector2f uv;  // Level-0 pixel coordinates.
+  // Level-0 pixel coordinates of the level pixel (pixel centres mapped through the resizing,
+  // patch_align.h LevelToImage).
+  Eigen::Vector2f uv;
   int octave = 0;      // Pyramid level.
   float angle = 0;     // Orientation in degrees [0, 360), as cv::KeyPoint.
   float response = 0;  // FAST score.
@@ -38,6 +41,7 @@ struct OrbKeypoint {
 struct OrbFeatures {
   std::vector<OrbKeypoint> keypoints;
   std::vector<Descriptor> descriptors;  // Same length as keypoints.
+  std::vector<cv::Mat> pyramid;         // Level images (level 0 = the grey image) if kept.
   size_t size() const { return keypoints.size(); }
 };
 

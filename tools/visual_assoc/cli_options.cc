@@ -37,8 +37,22 @@ void AddVisualMapFlags(CLI::App& cli, mapping::VisualMapOptions* o) {
   add("--min-observations", o->min_observations, "Culling: keyframes observing a point");
   add("--min-found-ratio", o->min_found_ratio, "Culling: found / visible ratio");
   add("--final-chi2", o->max_final_chi2, "Final outlier bound (x level variance)");
+  add("--track-chi2", o->track_chi2, "Tracking reprojection gate (x level variance, 0: off)");
   add("--min-covisibility", o->min_covisibility_weight, "Covisibility edge weight threshold");
   cli.add_option("--refine-points", o->refine_points, "Structure-only point refinement")
+      ->capture_default_str()
+      ->group("Method");
+  cli.add_option("--align-patches", o->align_patches,
+                 "Align observations to the point's reference patch (sub-pixel)")
+      ->capture_default_str()
+      ->group("Method");
+  cli.add_option("--require-alignment", o->require_alignment,
+                 "Drop observations whose patch does not align")
+      ->capture_default_str()
+      ->group("Method");
+  add("--align-min-ncc", o->align.min_ncc, "Correlation required of an aligned patch");
+  cli.add_option("--refine-on-insert", o->refine_on_insert,
+                 "Refine points and drop outlier observations as keyframes are added")
       ->capture_default_str()
       ->group("Method");
 }
