@@ -251,18 +251,30 @@ def run_task(jobs_path, index, run, dry_run):
         raise SpecError(f"task {index} ({phase} {seq} {config}): {missing[0]} is missing; "
                         "run the earlier phases first")
     print(f"task {index}: {phase} {seq} {config}", file=sys.stderr, flush=True)
+    out = os.path.join(run, seq, config)
+    product = os.path.join(out, "vps.h5" if phase == "common" else "metrics.json")
+    before = mtime(product)
     start = time.time()
     # close_fds=False keeps the make jobserver of a calling `make -j` open for the child.
     code = subprocess.run(cmd, cwd=ROOT, close_fds=False).returncode
     record = {"task": index, "phase": phase, "sequence": seq, "config": config,
               "exit_code": code, "wall_time_s": round(time.time() - start, 3),
               "command": shlex.join(cmd)}
-    out = os.path.join(run, seq, config)
+    # task.json keeps the time of the run that made the outputs, not of a later no-op rerun.
     os.makedirs(out, exist_ok=True)
-    with open(os.path.join(out, "task.json"), "w") as f:
-        json.dump(record, f, indent=1)
-        f.write("\n")
+    record_path = os.path.join(out, "task.json")
+    if code != 0 or mtime(product) != before or not os.path.isfile(record_path):
+        with open(record_path, "w") as f:
+            json.dump(record, f, indent=1)
+            f.write("\n")
     return code
+
+
+def mtime(path):
+    try:
+        return os.stat(path).st_mtime_ns
+    except OSError:
+        return None
 
 
 def batch_makefile(jobs_path, run):

@@ -60,7 +60,9 @@ def box_plot(table, sequences, path):
         ax.boxplot([v for _, v in boxes], showfliers=True, flierprops={"markersize": 2})
         ax.set_xticks(range(1, len(boxes) + 1))
         ax.set_xticklabels([label for label, _ in boxes], rotation=45, ha="right", fontsize=7)
-        ax.set_title(f"{seq}: APE per frame, {' x '.join(table['variables'])}", fontsize=9)
+        ax.set_title(f"{seq}: APE per frame", fontsize=9)
+        if len(table["variables"]) == 1:
+            ax.set_xlabel(table["variables"][0])
         ax.set_ylabel("APE (m)")
         ax.grid(alpha=0.3, axis="y")
     for ax in list(axes.flat)[len(panels):]:
