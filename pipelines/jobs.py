@@ -148,7 +148,7 @@ def config_name(diff):
     if not diff:
         return "base"
     parts = []
-    for var, value in diff.items():
+    for var, value in ordered(diff):  # a fixed order: one folder per configuration
         value = re.sub(r"[^A-Za-z0-9.+]+", "-", value).strip("-") or "default"
         parts.append(f"{var.lower()}-{value}")
     return "_".join(parts)
