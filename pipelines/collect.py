@@ -24,6 +24,7 @@ import json
 import os
 import subprocess
 import sys
+import textwrap
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import jobs  # noqa: E402
@@ -179,13 +180,13 @@ def table_rows(spec, variables, diffs):
 
 def markdown(c, cell_spec, digits, spec_name):
     what = "/".join(UNITS[n] for n in cell_spec)
-    lines = ["# Ablations", "",
-             f"Spec `{spec_name}`; each cell is {what} of \"{c.estimate}\", sequences in "
-             "columns. The last two rows are the base configuration's estimates without "
-             "direction priors and the prior. \"-\": undefined (r_rel and t_rel need segments "
-             "of at least 100 m); \"missing\": no result.", ""]
     base_vars = " ".join(f"{k}={v}" for k, v in jobs.ordered(c.spec.base)) or "(Makefile defaults)"
-    lines += [f"Base configuration: `{base_vars}`.", ""]
+    intro = (f"Spec `{spec_name}`, base configuration `{base_vars}`. Each cell is {what} of "
+             f"\"{c.estimate}\", sequences in columns. The last two rows are the base "
+             "configuration's estimates without direction priors and the prior. \"-\": "
+             "undefined (r_rel and t_rel need segments of at least 100 m); \"missing\": no "
+             "result.")
+    lines = ["# Ablations", "", textwrap.fill(intro, 100, break_on_hyphens=False), ""]
     for name, (variables, diffs) in zip(table_names(c.spec), c.spec.tables):
         header = " x ".join(variables)
         lines += [f"## {header}", "", f"| {header} | " + " | ".join(c.sequences) + " |",
