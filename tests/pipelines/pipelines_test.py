@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""Batch pipelines without running a stage: job-list generation, the per-task make command, the
+batch makefile, the Slurm submission (dry run) and the collect step on committed metrics.
+
+    python3 tests/pipelines/pipelines_test.py      (from the repository root; CTest does this)
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DATA = os.path.join(ROOT, "tests", "pipelines", "data")
+SPEC = os.path.join(DATA, "small.spec")
+JOBS_PY = os.path.join(ROOT, "pipelines", "jobs.py")
+COLLECT_PY = os.path.join(ROOT, "pipelines", "collect.py")
+
+
+def run(args, **kwargs):
+    return subprocess.run(args, capture_output=True, text=True, cwd=ROOT, **kwargs)
+
+
+def read(path):
+    with open(path) as f:
+        return f.read()
+
+
+class JobList(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="jvl_pipelines_")
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp)
+
+    def test_job_list_is_exact(self):
+        out = run([sys.executable, JOBS_PY, "list", SPEC])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertEqual(out.stdout, read(os.path.join(DATA, "expected_jobs.txt")))
+
+    def test_phases_partition_the_job_list(self):
+        expected = read(os.path.join(DATA, "expected_jobs.txt")).splitlines()
+        parts = []
+        for phase, count in (("common", 2), ("config", 8), ("reweight", 6)):
+            out = run([sys.executable, JOBS_PY, "list", SPEC, "--phase", phase])
+            lines = out.stdout.splitlines()
+            self.assertEqual(len(lines), count, phase)
+            self.assertTrue(all(l.startswith(phase + " ") for l in lines))
+            parts += lines
+        self.assertEqual(parts, expected)
+
+    def write_jobs(self):
+        jobs = os.path.join(self.tmp, "jobs.txt")
+        shutil.copy(os.path.join(DATA, "expected_jobs.txt"), jobs)
+        return jobs
+
+    def task_command(self, index):
+        out = run([sys.executable, JOBS_PY, "task", self.write_jobs(), str(index), "--dry-run"])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        return out.stdout.strip().replace(self.tmp, "RUN").replace(ROOT, "ROOT")
+
+    def test_task_commands(self):
+        make = "make --no-print-directory -f ROOT/Makefile.example "
+        d04 = "DATASET=../shared/data/kitti_odometry_04_f0-50/sequences/04"
+        self.assertEqual(self.task_command(1), make + d04 + " ODOM_N=1 OUT=RUN/04/common common")
+        # A config task reads the sequence's shared prior (lidar_odom) and vanishing points.
+        self.assertEqual(self.task_command(4), make + d04 + " PRIOR=RUN/04/common/odom.h5 "
+                         "ODOM_N=1 N=10 V_INTERVAL=5 ALIGN=none VPS=RUN/04/common/vps.h5 "
+                         "OUT=RUN/04/v_interval-5 all")
+        # An external prior is used as given; a reweight task reuses its upstream config.
+        self.assertEqual(self.task_command(16), make + "DATASET=/data/sim/sequences/00 "
+                         "PRIOR=/data/sim/prior.h5 N=10 V_INTERVAL=0 BETA=10 GAMMA=50 ALIGN=none "
+                         "UPSTREAM=RUN/sim/base VPS=RUN/sim/common/vps.h5 "
+                         "OUT=RUN/sim/beta-10_gamma-50 all")
+
+    def test_task_refuses_to_run_before_its_inputs_exist(self):
+        out = run([sys.executable, JOBS_PY, "task", self.write_jobs(), "11"])
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("04/common/vps.h5 is missing", out.stderr)
+        out = run([sys.executable, JOBS_PY, "task", self.write_jobs(), "17"])
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("task 17 out of range 1..16", out.stderr)
+
+    def test_batch_makefile_orders_the_tasks(self):
+        out = run([sys.executable, JOBS_PY, "makefile", self.write_jobs()])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        deps = {l.split(":")[0]: l.split(":")[1].split() for l in out.stdout.splitlines()
+                if l[:1] == "t" and ":" in l}
+        self.assertEqual(len(deps), 16)
+        self.assertEqual(deps["t1"], [])
+        self.assertEqual(deps["t4"], ["t1"])  # 04 v_interval-5 after 04 common
+        self.assertEqual(deps["t8"], ["t2"])  # sim v_interval-5 after sim common
+        self.assertEqual(deps["t16"], ["t2", "t7"])  # sim reweight after sim base
+
+    def test_spec_errors_name_the_line(self):
+        cases = [("sequence 04 /d\nvary V_INTERVALL=1,2\n", "bad.spec:2: unknown variable"),
+                 ("sequence 04 /d\nvary DATASET=/a,/b\n", "bad.spec:2: DATASET cannot vary"),
+                 ("set N=1\n", "bad.spec: no 'sequence' line"),
+                 ("sequence 04 /d\nfoo N=1\n", "bad.spec:2: unknown keyword 'foo'"),
+                 ("sequence 04 /d\nvary N=1 V_INTERVAL=2\n", "bad.spec:2: expected 'vary")]
+        for text, message in cases:
+            spec = os.path.join(self.tmp, "bad.spec")
+            with open(spec, "w") as f:
+                f.write(text)
+            out = run([sys.executable, JOBS_PY, "list", spec])
+            self.assertEqual(out.returncode, 2, text)
+            self.assertIn(message, out.stderr, text)
+            self.assertEqual(len(out.stderr.strip().splitlines()), 1, out.stderr)
+
+    def test_slurm_submit_dry_run(self):
+        out = run(["bash", os.path.join(ROOT, "pipelines", "slurm", "submit"), SPEC, self.tmp,
+                   "--dry-run", "--partition=cpu"])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        lines = out.stdout.splitlines()
+        self.assertEqual(len(lines), 4)
+        for line, phase, n in zip(lines, ("common", "config", "reweight"), (2, 8, 6)):
+            self.assertIn(f"--job-name=jvl-{phase} --array=1-{n} ", line)
+            self.assertIn("--partition=cpu", line)
+            self.assertTrue(line.strip().endswith(f"task.sbatch {self.tmp}/jobs.{phase}.txt"))
+        self.assertIn("--dependency=afterany:\\$JOB_common", lines[1])
+        self.assertIn("--dependency=afterany:\\$JOB_reweight", lines[3])
+        self.assertIn("collect.sbatch", lines[3])
+        self.assertEqual(read(os.path.join(self.tmp, "jobs.txt")),
+                         read(os.path.join(DATA, "expected_jobs.txt")))
+
+    def test_local_batch_dry_run(self):
+        out = run(["bash", os.path.join(ROOT, "pipelines", "batch"), SPEC, self.tmp, "--dry-run"])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        lines = out.stdout.splitlines()
+        self.assertEqual(len(lines), 16)
+        self.assertTrue(all("-f " + os.path.join(ROOT, "Makefile.example") in l for l in lines))
+        self.assertTrue(os.path.isfile(os.path.join(self.tmp, "batch.mk")))
+
+
+class Collect(unittest.TestCase):
+    """The committed metrics of tests/pipelines/data/run (one task, sim/beta-10, failed)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="jvl_collect_")
+        cls.out = run([sys.executable, COLLECT_PY, SPEC, os.path.join(DATA, "run"), "-o",
+                       cls.tmp, "--no-plots"])
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp)
+
+    def test_reports_the_missing_result(self):
+        self.assertEqual(self.out.returncode, 0, self.out.stderr)
+        self.assertIn("13/14 results", self.out.stdout)
+        self.assertIn("run/sim/beta-10/metrics.json is missing", self.out.stderr)
+
+    def test_outputs_match_the_expected_files(self):
+        for name in ("ablations.md", "v_interval.csv", "n.csv", "beta_gamma.csv", "metrics.csv"):
+            with self.subTest(name=name):
+                self.assertEqual(read(os.path.join(self.tmp, name)),
+                                 read(os.path.join(DATA, "expected", name)))
+
+    def test_paper_format(self):
+        table = read(os.path.join(self.tmp, "v_interval.csv")).splitlines()
+        self.assertEqual(table[0], "V_INTERVAL,config,04,sim")
+        # r_rel / APE; r_rel is undefined on the 04 excerpt (no 100 m segment).
+        self.assertEqual(table[2], "5,v_interval-5,-/0.310,0.201/1.310")
+
+    def test_other_cells_and_estimates(self):
+        out = run([sys.executable, COLLECT_PY, SPEC, os.path.join(DATA, "run"), "-o", self.tmp
+                   + "/x", "--no-plots", "--cell", "ape_deg/ape", "--estimate",
+                   "w.o. direction priors"])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        table = read(os.path.join(self.tmp, "x", "n.csv")).splitlines()
+        self.assertEqual(table[1], "1,n-1,0.215/0.430,0.715/1.430")
+
+    def test_bad_input(self):
+        out = run([sys.executable, COLLECT_PY, SPEC, os.path.join(self.tmp, "nothing")])
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("no such run folder", out.stderr)
+        os.makedirs(os.path.join(self.tmp, "empty"), exist_ok=True)
+        out = run([sys.executable, COLLECT_PY, SPEC, os.path.join(self.tmp, "empty"),
+                   "--no-plots"])
+        self.assertEqual(out.returncode, 1)
+        self.assertIn("no metrics.json", out.stderr.splitlines()[-1])
+        out = run([sys.executable, COLLECT_PY, SPEC, DATA, "--cell", "r_rel/apex"])
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("unknown figure 'apex'", out.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
