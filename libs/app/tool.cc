@@ -53,7 +53,27 @@ int Tool::Run(int argc, const char* const* argv, const std::function<void()>& bo
   return 1;
 }
 
-void Tool::AddInput(const std::string& path) { inputs_.push_back(io::DescribeFile(path)); }
+void Tool::SetDatasetId(const std::string& id, const std::string& source) {
+  JVL_CHECK(dataset_id_.empty() || id.empty() || id == dataset_id_,
+            source << " is sequence '" << id << "' but " << dataset_source_ << " was made from '"
+                   << dataset_id_ << "' (inputs of different sequences)");
+  if (id.empty()) return;
+  dataset_id_ = id;
+  dataset_source_ = source;
+}
+
+void Tool::AddInput(const std::string& path, bool same_dataset) {
+  inputs_.push_back(io::DescribeFile(path));
+  if (!same_dataset) return;
+  const std::string id = io::ReadArtifactDatasetId(path);
+  JVL_CHECK(dataset_id_.empty() || id.empty() || id == dataset_id_,
+            path << " was made from sequence '" << id << "' but " << dataset_source_ << " is '"
+                 << dataset_id_ << "' (inputs of different sequences)");
+  if (!id.empty() && dataset_id_.empty()) {
+    dataset_id_ = id;
+    dataset_source_ = path;
+  }
+}
 
 nlohmann::json Tool::OptionsJson() const {
   nlohmann::json j = nlohmann::json::object();

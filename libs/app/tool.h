@@ -34,9 +34,13 @@ class Tool {
   // Parses argv and runs body. Returns the process exit code.
   int Run(int argc, const char* const* argv, const std::function<void()>& body);
 
-  // Records an input file (path, size, content hash) for the provenance.
-  void AddInput(const std::string& path);
-  void SetDatasetId(const std::string& id) { dataset_id_ = id; }
+  // Records an input file (path, size, content hash) for the provenance. The dataset id in an
+  // artifact's provenance must match the run's (from SetDatasetId or an earlier input), so that
+  // artifacts of different sequences are not mixed; the first one seen becomes the run's id.
+  // Pass same_dataset = false for inputs that may come from other sequences (evaluate).
+  void AddInput(const std::string& path, bool same_dataset = true);
+  // The sequence this run works on (`source` names it in errors, e.g. the dataset folder).
+  void SetDatasetId(const std::string& id, const std::string& source = "the dataset");
   // Provenance of this run so far: options, inputs, wall time and peak memory.
   io::Provenance MakeProvenance() const;
   // Options as JSON (name -> value as given or defaulted).
@@ -50,6 +54,7 @@ class Tool {
   bool quiet_ = false;
   std::vector<io::FileInfo> inputs_;
   std::string dataset_id_;
+  std::string dataset_source_;  // What dataset_id_ came from, for error messages.
   Timer timer_;
 };
 

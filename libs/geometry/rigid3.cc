@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <cmath>
+#include <limits>
 
 namespace jvl {
 
@@ -18,6 +19,11 @@ Rigid3d Rigid3d::FromMatrix(const Eigen::Matrix<double, 3, 4>& m) {
     r = u * svd.matrixV().transpose();
   }
   return Rigid3d(r, m.col(3));
+}
+
+double Rigid3d::RotationDeviation(const Eigen::Matrix3d& m) {
+  if (!m.allFinite() || !(m.determinant() > 0)) return std::numeric_limits<double>::infinity();
+  return (m.transpose() * m - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
 }
 
 Rigid3d Rigid3d::FromArray(const double* a) {

@@ -19,6 +19,9 @@ class Rigid3d {
   Rigid3d(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation);
   // From a 3x4 or 4x4 matrix [R | t]; the rotation is projected onto SO(3).
   static Rigid3d FromMatrix(const Eigen::Matrix<double, 3, 4>& m);
+  // Largest entry of |m^T m - I| for the 3x3 part of a matrix read from text (infinity when it is
+  // not finite or det(m) <= 0): readers reject values far above KITTI's ~1e-7 before FromMatrix.
+  static double RotationDeviation(const Eigen::Matrix3d& m);
   // [qx, qy, qz, qw, tx, ty, tz].
   static Rigid3d FromArray(const double* q_xyzw_t);
 

@@ -349,11 +349,34 @@ herr_t CollectDataset(hid_t, const char* name, const ObjectInfo* info, void* dat
   if (info->type == H5O_TYPE_DATASET) static_cast<std::vector<std::string>*>(data)->push_back(name);
   return 0;
 }
+herr_t CollectObject(hid_t, const char* name, const ObjectInfo*, void* data) {
+  static_cast<std::vector<std::string>*>(data)->push_back(name);
+  return 0;
+}
+herr_t CollectAttribute(hid_t, const char* name, const H5A_info_t*, void* data) {
+  static_cast<std::vector<std::string>*>(data)->push_back(name);
+  return 0;
+}
 }  // namespace
 
 std::vector<std::string> H5Reader::ListDatasets() const {
   std::vector<std::string> names;
   JVL_H5_VISIT(impl_->file, CollectDataset, &names);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::vector<std::string> H5Reader::ListAttributes() const {
+  std::vector<std::string> objects, names;
+  JVL_H5_VISIT(impl_->file, CollectObject, &objects);  // "." is the root.
+  for (const std::string& object : objects) {
+    Handle obj(H5Oopen(impl_->file, object.c_str(), H5P_DEFAULT), H5Oclose);
+    JVL_CHECK(obj.ok(), impl_->path << ": cannot open '" << object << "'");
+    std::vector<std::string> attrs;
+    hsize_t index = 0;
+    H5Aiterate2(obj.get(), H5_INDEX_NAME, H5_ITER_INC, &index, CollectAttribute, &attrs);
+    for (const std::string& a : attrs) names.push_back(object == "." ? a : object + "/" + a);
+  }
   std::sort(names.begin(), names.end());
   return names;
 }
@@ -417,6 +440,28 @@ nlohmann::json H5Reader::provenance() const {
 }
 
 // ---------------------------------------------------------------------------------------------
+std::string ReadArtifactDatasetId(const std::string& path) {
+  SilenceHdf5Errors();
+  nlohmann::json provenance;
+  if (H5Fis_hdf5(path.c_str()) > 0) {
+    try {
+      provenance = H5Reader(path, "", 0).provenance();
+    } catch (const Error&) {
+      return "";  // Not a jvl artifact: its reader reports that.
+    }
+  } else if (path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0) {
+    try {
+      const nlohmann::json j = nlohmann::json::parse(ReadTextFile(path));
+      if (j.is_object() && j.contains("provenance")) provenance = j["provenance"];
+    } catch (const std::exception&) {
+      return "";
+    }
+  }
+  if (!provenance.is_object() || !provenance.contains("dataset_id")) return "";
+  const nlohmann::json& id = provenance["dataset_id"];
+  return id.is_string() ? id.get<std::string>() : "";
+}
+
 void WriteJsonArtifact(const std::string& path, const std::string& schema, int schema_version,
                        const nlohmann::json& body, const Provenance& provenance) {
   nlohmann::json j = nlohmann::json::object();

@@ -75,6 +75,9 @@ class H5Reader {
   std::string DatasetType(const std::string& name) const;
   // Names of all datasets ("group/name"), sorted.
   std::vector<std::string> ListDatasets() const;
+  // Names of all attributes as ReadString takes them ("attr" on the root, "group/attr" on a group
+  // or dataset), sorted.
+  std::vector<std::string> ListAttributes() const;
   // Reads a dataset converting to T; `expected_cols` > 0 checks a 2-D shape (N x cols).
   template <typename T>
   std::vector<T> ReadArray(const std::string& name, int64_t expected_cols = 0) const;
@@ -89,6 +92,10 @@ class H5Reader {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The dataset id in the provenance of an HDF5 or JSON artifact; "" for other files (trajectory
+// text) and artifacts without one.
+std::string ReadArtifactDatasetId(const std::string& path);
 
 // JSON artifacts: {"schema": ..., "schema_version": ..., "provenance": {...}, ...body}.
 void WriteJsonArtifact(const std::string& path, const std::string& schema, int schema_version,

@@ -68,6 +68,8 @@ TEST_F(ArtifactTest, ArraysAttributesAndProvenanceRoundTrip) {
   EXPECT_FALSE(r.Has("group/nope/deeper"));
   EXPECT_EQ(r.ListDatasets(),
             (std::vector<std::string>{"bytes", "empty", "group/sub/values"}));
+  EXPECT_EQ(r.ListAttributes(), (std::vector<std::string>{"group/note", "meta", "provenance",
+                                                          "schema", "schema_version"}));
   EXPECT_THROW(r.ReadArray<double>("group/sub/values", 4), Error);
 }
 
@@ -114,6 +116,28 @@ TEST_F(ArtifactTest, AtomicWriteKeepsOldFileWhenWriterFails) {
                            }),
                Error);
   EXPECT_EQ(ReadTextFile(Path("x.txt")), "old");
+}
+
+TEST_F(ArtifactTest, AtomicWriteNamesWhyTheRenameFailed) {
+  fs::create_directories(Path("taken/child"));  // A non-empty folder under the final name.
+  const std::string message = ErrorOf([&] { WriteTextFileAtomic(Path("taken"), "new"); });
+  EXPECT_NE(message.find("cannot move the finished file into place"), std::string::npos);
+  EXPECT_EQ(message.find("Success"), std::string::npos) << message;
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
+}
+
+TEST_F(ArtifactTest, DatasetIdOfArtifactsAndOtherFiles) {
+  Provenance p;
+  p.dataset_id = "kitti:04:abcd";
+  WriteTrajectoryArtifact(Path("t.h5"), Small(), p);
+  WriteJsonArtifact(Path("m.json"), "demo", 1, {{"x", 1}}, p);
+  WriteTrajectoryKitti(Path("t.txt"), Small());
+  EXPECT_EQ(ReadArtifactDatasetId(Path("t.h5")), "kitti:04:abcd");
+  EXPECT_EQ(ReadArtifactDatasetId(Path("m.json")), "kitti:04:abcd");
+  EXPECT_EQ(ReadArtifactDatasetId(Path("t.txt")), "");
+  WriteTextFileAtomic(Path("bad.json"), "{not json");
+  EXPECT_EQ(ReadArtifactDatasetId(Path("bad.json")), "");
 }
 
 TEST_F(ArtifactTest, SameContentGivesSameBytesApartFromProvenance) {

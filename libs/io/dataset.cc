@@ -85,6 +85,7 @@ PointCloud LoadScanChecked(const std::string& path, int64_t frame, size_t* dropp
   if (bad > 0) {
     spdlog::warn("{}: dropped {} non-finite points (frame {})", path, bad, frame);
   }
+  if (cloud.empty()) spdlog::warn("{}: empty scan (frame {})", path, frame);
   if (dropped) *dropped = bad;
   return cloud;
 }

@@ -85,8 +85,9 @@ void AtomicWrite(const std::string& path, const std::function<void(const std::st
   std::error_code ec;
   fs::rename(tmp, final_path, ec);
   if (ec) {
+    const std::string reason = ec.message();  // remove() below resets ec.
     fs::remove(tmp, ec);
-    JVL_THROW(path << ": cannot move the finished file into place (" << ec.message() << ")");
+    JVL_THROW(path << ": cannot move the finished file into place (" << reason << ")");
   }
 }
 

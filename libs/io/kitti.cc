@@ -66,6 +66,10 @@ Calibration ParseKittiCalibration(std::istream& in, const std::string& name) {
               name << ":" << line_no << ": expected 'KEY: values', got '" << body << "'");
     const std::string key(Trim(body.substr(0, colon)));
     const auto tokens = SplitWhitespace(body.substr(colon + 1));
+    const bool required =
+        key == "Tr" || (key.size() == 2 && key[0] == 'P' && key[1] >= '0' && key[1] <= '3');
+    JVL_CHECK(!required || tokens.size() == 12, name << ":" << line_no << ": " << key << " has "
+                                                     << tokens.size() << " numbers, expected 12");
     if (tokens.size() != 12) continue;  // Other entries (e.g. S_rect sizes) are not 3x4.
     Eigen::Matrix<double, 3, 4> m;
     for (int i = 0; i < 12; ++i) {
@@ -83,8 +87,15 @@ Calibration ParseKittiCalibration(std::istream& in, const std::string& name) {
     calib.P[i] = entries[key];
   }
   JVL_CHECK(entries.count("Tr"), name << ": missing Tr (velodyne to cam0, 3x4)");
+  const double deviation = Rigid3d::RotationDeviation(entries["Tr"].leftCols<3>());
+  JVL_CHECK(deviation < 1e-2,
+            name << ": Tr is not a rigid transform (rotation part off by " << deviation << ")");
   calib.cam0_from_velo = Rigid3d::FromMatrix(entries["Tr"]);
-  calib.Camera(0).Check();
+  try {
+    calib.Camera(0).Check();
+  } catch (const Error& e) {
+    JVL_THROW(name << ": P0: " << e.message());
+  }
   return calib;
 }
 
@@ -144,9 +155,35 @@ void WriteKittiTimes(const std::string& path, const std::vector<double>& times) 
   WriteTextFileAtomic(path, out);
 }
 
+namespace {
+
+// A PNG starts with its 8-byte signature and ends with the 12-byte IEND chunk. Checking both
+// before decoding names a truncated file clearly, and keeps libpng from printing its own error.
+constexpr unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+constexpr unsigned char kPngIend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+
+bool LooksLikeCompletePng(const std::string& bytes) {
+  return bytes.size() >= 20 && std::memcmp(bytes.data(), kPngSignature, 8) == 0 &&
+         std::memcmp(bytes.data() + bytes.size() - 12, kPngIend, 12) == 0;
+}
+
+}  // namespace
+
 cv::Mat ReadImage(const std::string& path, bool grayscale) {
   JVL_CHECK(FileExists(path), path << ": image not found");
-  cv::Mat image = cv::imread(path, grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_UNCHANGED);
+  const std::string bytes = ReadTextFile(path);
+  JVL_CHECK(!bytes.empty(), path << ": empty image file");
+  JVL_CHECK(bytes.size() < (1u << 31), path << ": image file too large");
+  const bool png = bytes.size() >= 4 && bytes.compare(1, 3, "PNG") == 0;
+  JVL_CHECK(!png || LooksLikeCompletePng(bytes),
+            path << ": truncated PNG (no IEND chunk at the end)");
+  const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data()));
+  cv::Mat image;
+  try {
+    image = cv::imdecode(buffer, grayscale ? cv::IMREAD_GRAYSCALE : cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception&) {
+    image.release();  // OpenCV's own assertion text would not name the file.
+  }
   JVL_CHECK(!image.empty(), path << ": image does not decode (damaged or not an image)");
   return image;
 }

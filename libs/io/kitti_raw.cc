@@ -98,10 +98,14 @@ const std::vector<double>& Require(const std::map<std::string, std::vector<doubl
   return it->second;
 }
 
-Rigid3d RigidFromRT(const std::vector<double>& r, const std::vector<double>& t) {
+Rigid3d RigidFromRT(const std::vector<double>& r, const std::vector<double>& t,
+                    const std::string& path) {
   Eigen::Matrix<double, 3, 4> m;
   for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = r[i];
   m.col(3) = Eigen::Vector3d(t[0], t[1], t[2]);
+  const double deviation = Rigid3d::RotationDeviation(m.leftCols<3>());
+  JVL_CHECK(deviation < 1e-2 && m.col(3).allFinite(),
+            path << ": not a rigid transform (rotation part off by " << deviation << ")");
   return Rigid3d::FromMatrix(m);
 }
 
@@ -145,16 +149,21 @@ class KittiRawDataset : public Dataset {
     const auto cam = ReadKeyValues(c2c);
     for (int i = 0; i < 4; ++i) {
       const auto& v = Require(cam, "P_rect_0" + std::to_string(i), 12, c2c);
-      for (int k = 0; k < 12; ++k) calibration_.P[i](k / 4, k % 4) = v[k];
+      for (int k = 0; k < 12; ++k) {
+        JVL_CHECK(std::isfinite(v[k]), c2c << ": P_rect_0" << i << " has a non-finite value");
+        calibration_.P[i](k / 4, k % 4) = v[k];
+      }
     }
     const auto& rr = Require(cam, "R_rect_00", 9, c2c);
-    const Rigid3d rect_from_cam0 = RigidFromRT(rr, {0, 0, 0});
+    const Rigid3d rect_from_cam0 = RigidFromRT(rr, {0, 0, 0}, c2c);
     const auto& size = Require(cam, "S_rect_00", 2, c2c);
+    JVL_CHECK(size[0] >= 1 && size[0] <= 1e5 && size[1] >= 1 && size[1] <= 1e5,
+              c2c << ": S_rect_00 is not an image size");
     calibration_.image_width = static_cast<int>(size[0]);
     calibration_.image_height = static_cast<int>(size[1]);
     const auto velo = ReadKeyValues(v2c);
     const Rigid3d cam0_from_velo_unrect =
-        RigidFromRT(Require(velo, "R", 9, v2c), Require(velo, "T", 3, v2c));
+        RigidFromRT(Require(velo, "R", 9, v2c), Require(velo, "T", 3, v2c), v2c);
     calibration_.cam0_from_velo = rect_from_cam0 * cam0_from_velo_unrect;
 
     scans_ = ListNumbered(drive / "velodyne_points" / "data", ".bin");
@@ -197,7 +206,8 @@ class KittiRawDataset : public Dataset {
       }
       const auto imu0_from_imu = OxtsToImuPoses(packets);
       const auto imu = ReadKeyValues(i2v);
-      const Rigid3d velo_from_imu = RigidFromRT(Require(imu, "R", 9, i2v), Require(imu, "T", 3, i2v));
+      const Rigid3d velo_from_imu =
+          RigidFromRT(Require(imu, "R", 9, i2v), Require(imu, "T", 3, i2v), i2v);
       const Rigid3d cam0_from_imu = calibration_.cam0_from_velo * velo_from_imu;
       const Rigid3d imu_from_cam0 = cam0_from_imu.Inverse();
       Trajectory gt;

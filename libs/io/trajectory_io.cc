@@ -79,7 +79,7 @@ Trajectory ReadTrajectoryText(std::istream& in, TrajectoryFormat format, const s
     const size_t off = format == TrajectoryFormat::kKittiIndexed ? 1 : 0;
     int64_t frame = static_cast<int64_t>(t.size());
     if (off == 1) {
-      JVL_CHECK(v[0] >= 0 && v[0] == std::floor(v[0]),
+      JVL_CHECK(v[0] >= 0 && v[0] < 1e15 && v[0] == std::floor(v[0]),
                 name << ":" << line_no << ": frame index '" << tokens[0] << "' is not an integer");
       frame = static_cast<int64_t>(v[0]);
     }

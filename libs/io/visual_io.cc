@@ -25,6 +25,33 @@ void CheckIndices(const std::vector<T>& v, size_t bound, const char* name,
 
 }  // namespace
 
+std::vector<int64_t> VisualMapData::CovisibilityPartStarts() const {
+  std::vector<std::vector<int32_t>> adjacency(keyframes.size());
+  for (size_t e = 0; e < num_edges(); ++e) {
+    const int32_t a = covisibility_edges[2 * e], b = covisibility_edges[2 * e + 1];
+    adjacency[static_cast<size_t>(a)].push_back(b);
+    adjacency[static_cast<size_t>(b)].push_back(a);
+  }
+  std::vector<uint8_t> seen(keyframes.size(), 0);
+  std::vector<int64_t> starts;
+  for (size_t root = 0; root < adjacency.size(); ++root) {
+    if (seen[root]) continue;
+    starts.push_back(keyframes.frames[root]);
+    std::vector<size_t> stack = {root};
+    seen[root] = 1;
+    while (!stack.empty()) {
+      const size_t k = stack.back();
+      stack.pop_back();
+      for (const int32_t next : adjacency[k]) {
+        if (seen[static_cast<size_t>(next)]) continue;
+        seen[static_cast<size_t>(next)] = 1;
+        stack.push_back(static_cast<size_t>(next));
+      }
+    }
+  }
+  return starts;
+}
+
 void VisualMapData::Check(const std::string& what) const {
   keyframes.Check((what + " keyframes").c_str());
   const size_t p = num_keypoints(), m = num_mappoints(), o = num_observations(), e = num_edges();

@@ -53,6 +53,9 @@ struct VisualMapData {
   size_t num_edges() const { return covisibility_weight.size(); }
   // Sizes agree and all indices are in range; throws naming `what`.
   void Check(const std::string& what) const;
+  // Connected parts of the covisibility graph: the frame of the first keyframe of each part, in
+  // keyframe order (one entry when the graph is connected, none without keyframes).
+  std::vector<int64_t> CovisibilityPartStarts() const;
 };
 
 void WriteVisualMap(const std::string& path, const VisualMapData& data,

@@ -78,6 +78,15 @@ TEST(VisualIo, RoundTrip) {
   fs::remove(path);
 }
 
+TEST(VisualIo, CovisibilityParts) {
+  VisualMapData d = MakeMap();
+  EXPECT_EQ(d.CovisibilityPartStarts(), (std::vector<int64_t>{3}));
+  d.covisibility_edges.clear();
+  d.covisibility_weight.clear();
+  EXPECT_EQ(d.CovisibilityPartStarts(), (std::vector<int64_t>{3, 5}));
+  EXPECT_TRUE(VisualMapData().CovisibilityPartStarts().empty());
+}
+
 TEST(VisualIo, RejectsInconsistentIndices) {
   VisualMapData d = MakeMap();
   d.observation_keypoint[0] = 4;  // A keypoint of keyframe 1 for an observation in keyframe 0.

@@ -50,14 +50,20 @@ ceres::Solver::Options MakeSolverOptions(JointProblem& jp, const SolveOptions& o
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     return so;
   }
-  // Bundle-adjustment structure: eliminate the map points first (Schur complement).
+  // Bundle-adjustment structure: eliminate the map points first (Schur complement). Ceres keeps
+  // the blocks of one group in address order; the poses live in map nodes whose addresses
+  // depend on the process's heap history, so with one group for all poses the Schur complement
+  // was assembled in a different order from run to run and results differed in the last bits.
+  // One group per pose, in keyframe-id order, makes the order that of the ids (the points are
+  // one contiguous array, so their address order is their index order).
   so.linear_solver_type = ceres::SPARSE_SCHUR;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (auto& point : jp.map_points) {
     if (jp.problem->HasParameterBlock(point.data())) ordering->AddElementToGroup(point.data(), 0);
   }
-  for (auto& [id, block] : jp.poses) ordering->AddElementToGroup(block.data(), 1);
-  for (auto& d : jp.free_directions) ordering->AddElementToGroup(d.data(), 1);
+  int group = 1;
+  for (auto& [id, block] : jp.poses) ordering->AddElementToGroup(block.data(), group++);
+  for (auto& d : jp.free_directions) ordering->AddElementToGroup(d.data(), group++);
   so.linear_solver_ordering = ordering;
   return so;
 }

@@ -17,7 +17,11 @@ void PriorOptions::Check() const {
                    jitter_translation_m, jitter_rotation_deg}) {
     JVL_CHECK(v >= 0 && std::isfinite(v), "prior noise levels must be finite and >= 0");
   }
-  JVL_CHECK(std::abs(scale_bias) < 0.5, "scale bias must be in (-0.5, 0.5)");
+  JVL_CHECK(std::abs(scale_bias) < 0.5,
+            "scale bias (--scale-bias) must be in (-0.5, 0.5), got " << scale_bias);
+  JVL_CHECK(
+      std::abs(yaw_bias_deg_per_100m) <= 180,
+      "yaw drift (--yaw-drift) must be within +-180 deg/100 m, got " << yaw_bias_deg_per_100m);
 }
 
 std::vector<std::string> PriorPresetNames() { return {"lidar-n1", "orbslam2", "good", "none"}; }

@@ -1,6 +1,7 @@
 #include "vision/line_segments.h"
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
@@ -32,9 +33,10 @@ bool FastLineDetectorAvailable() {
 void LineSegmentOptions::Check() const {
   JVL_CHECK(scale > 0.05 && scale <= 1.0, "line scale must be in (0.05, 1], got " << scale);
   JVL_CHECK(min_length_px >= 0, "min segment length must be >= 0, got " << min_length_px);
-  JVL_CHECK(
-      canny_low >= 0 && canny_high >= canny_low,
-      "Canny thresholds must satisfy 0 <= low <= high, got " << canny_low << ", " << canny_high);
+  // The fast line detector asserts on zero thresholds, so they must be strictly positive.
+  JVL_CHECK(canny_low > 0 && canny_high >= canny_low && std::isfinite(canny_high),
+            "Canny thresholds (--canny-low, --canny-high) must satisfy 0 < low <= high, got "
+                << canny_low << ", " << canny_high);
   JVL_CHECK(detector != LineDetector::kFld || FastLineDetectorAvailable(),
             "line detector 'fld' needs opencv_ximgproc, which this build lacks; use lsd");
 }

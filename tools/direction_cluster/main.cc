@@ -128,12 +128,18 @@ int main(int argc, char** argv) {
       JVL_CHECK(!dataset.empty(), vps_path << " has no camera; pass --dataset for the intrinsics");
       const auto ds = io::OpenDataset(dataset);
       camera = ds->calibration().Camera(0);
-      tool.SetDatasetId(ds->id());
+      tool.SetDatasetId(ds->id(), dataset);
     }
     const auto result = direction::ClusterDirections(ToObservations(vps), prior, camera, o);
     if (result.stats.missing_prior > 0)
       spdlog::warn("{} VPs skipped: their frames are not in the prior {}",
                    result.stats.missing_prior, prior_path);
+    if (result.associations.empty()) {
+      spdlog::warn(
+          "no direction prior found ({} VPs in {}); visual_assoc and global_opt will "
+          "run without direction priors",
+          result.stats.input_vps, vps_path);
+    }
     const io::DirectionsData data = ToData(result, o.v_interval);
     io::WriteDirectionsArtifact(output, data, tool.MakeProvenance());
     if (!csv.empty()) io::WriteDirectionsCsv(csv, data);

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     c.options.association.mode = jvl::eval::ParseAssociationMode(assoc);
     c.options.rpe.unit = jvl::eval::ParseRpeUnit(rpe_unit);
     const jvl::tools::EvaluateRun run = jvl::tools::RunEvaluation(c);
-    for (const std::string& input : run.inputs) tool.AddInput(input);
+    for (const std::string& input : run.inputs) tool.AddInput(input, /*same_dataset=*/false);
     std::fputs(jvl::eval::FormatTable(run.estimates, c.options).c_str(), stdout);
     std::fflush(stdout);
     if (!json.empty()) {

@@ -1,6 +1,7 @@
 // global_opt: global joint optimisation of all keyframes with direction priors (Sec. 4.3,
 // Eq. 5-8). Reads only artifacts (local.h5, visual.h5, directions.h5, optional prior), so a rerun
 // with other weights needs neither the dataset nor a new feature association.
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "app/tool.h"
@@ -84,16 +85,34 @@ int main(int argc, char** argv) {
     o.fresh_traversal = !no_fresh;
     o.solve.threads = tool.threads();
     o.Check();
+    JVL_CHECK(map_voxel == 0 || (map_voxel >= 0.01 && map_voxel <= 100),
+              "--map-voxel must be 0 (every point) or in [0.01, 100] m, got " << map_voxel);
     JVL_CHECK(no_direction || !directions_path.empty(),
               "--directions is required unless --no-direction is given");
     const auto visual = io::ReadVisualMap(visual_path);
     tool.AddInput(visual_path);
+    JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to optimise)");
     const auto local = global_opt::ReadLocalInput(local_path);
     tool.AddInput(local_path);
+    JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
+              local_path << " and " << visual_path << " have different keyframes ("
+                         << local.keyframes.size() << " vs " << visual.keyframes.size()
+                         << "): local_map must have run on this visual artifact");
+    const std::vector<int64_t> parts = visual.CovisibilityPartStarts();
+    if (parts.size() > 1) {
+      spdlog::warn(
+          "{}: the covisibility graph has {} parts (starting at frames {}); keyframes of "
+          "different parts share no map point and are joined only by the LiDAR terms",
+          visual_path, parts.size(), fmt::join(parts, ", "));
+    }
     io::DirectionsData directions;
     if (!directions_path.empty()) {
       directions = io::ReadDirectionsArtifact(directions_path);
       tool.AddInput(directions_path);
+      if (!no_direction && directions.associations.empty()) {
+        spdlog::warn("{}: no direction prior (no associated VP); optimising without e_D",
+                     directions_path);
+      }
     }
     Trajectory prior = local.prior.empty() ? visual.prior : local.prior;
     if (!prior_path.empty()) {

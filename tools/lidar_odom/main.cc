@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     options.Check();
     const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
                                               jvl::ParseFrameRange(frames));
-    tool.SetDatasetId(dataset->id());
+    tool.SetDatasetId(dataset->id(), dataset_dir);
     for (const std::string& f : dataset->KeyFiles()) tool.AddInput(f);
     jvl::lidar::Odometry odometry(dataset->calibration().cam0_from_velo, options, tool.threads());
     jvl::io::OdometryArtifact artifact;

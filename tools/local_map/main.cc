@@ -1,11 +1,13 @@
 // local_map: joint visual + point-to-IMLS optimisation per keyframe (paper Sec. 4.2,
 // supplement 1.2) over the visual map of visual_assoc and the dataset's scans.
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
 
 #include "app/tool.h"
 #include "cli_options.h"
+#include "core/check.h"
 #include "core/progress.h"
 #include "io/dataset.h"
 #include "io/local_io.h"
@@ -35,6 +37,14 @@ int main(int argc, char** argv) {
     scan_options.Check();
     const io::VisualMapData visual = io::ReadVisualMap(visual_path);
     tool.AddInput(visual_path);
+    JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to refine)");
+    const std::vector<int64_t> parts = visual.CovisibilityPartStarts();
+    if (parts.size() > 1) {
+      spdlog::warn(
+          "{}: the covisibility graph has {} parts (starting at frames {}); keyframes of "
+          "different parts share no map point and are joined only by the LiDAR terms",
+          visual_path, parts.size(), fmt::join(parts, ", "));
+    }
     Trajectory prior = visual.prior;
     if (!prior_path.empty()) {
       prior = io::ReadTrajectory(prior_path);
@@ -43,7 +53,7 @@ int main(int argc, char** argv) {
     const auto input = mapping::MakeLocalMappingInput(
         visual, prior, prior_path.empty() ? visual_path + " (prior)" : prior_path);
     auto dataset = io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), FrameRange());
-    tool.SetDatasetId(dataset->id());
+    tool.SetDatasetId(dataset->id(), dataset_dir);
     for (const auto& f : dataset->KeyFiles()) tool.AddInput(f);
     const Rigid3d cam0_from_velo = dataset->calibration().cam0_from_velo;
     // Candidates per sampling list, as lidar_odom: sampling stops after s accepted points.

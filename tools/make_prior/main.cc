@@ -10,19 +10,21 @@ int main(int argc, char** argv) {
   jvl::app::Tool tool("make_prior", "Make a drifting prior trajectory from ground truth.");
   std::string gt_path, output, preset = "lidar-n1";
   uint64_t seed = 1;
-  double yaw_drift = -1, scale_bias = -1;
+  double yaw_drift = 0, scale_bias = 0;
   auto& cli = tool.cli();
   cli.add_option("--ground-truth,-g", gt_path, "Ground truth (KITTI/TUM text or .h5)")->required();
   cli.add_option("--output,-o", output, "Prior: .h5 trajectory artifact or .txt (KITTI)")
       ->required();
   cli.add_option("--preset", preset, "lidar-n1, orbslam2, good or none")->capture_default_str();
   cli.add_option("--seed", seed, "Random seed")->capture_default_str();
-  cli.add_option("--yaw-drift", yaw_drift, "Override: constant yaw drift (deg/100 m)");
-  cli.add_option("--scale-bias", scale_bias, "Override: relative scale error (0.01 = 1 %)");
+  const CLI::Option* yaw_option =
+      cli.add_option("--yaw-drift", yaw_drift, "Override: constant yaw drift (deg/100 m)");
+  const CLI::Option* scale_option =
+      cli.add_option("--scale-bias", scale_bias, "Override: relative scale error (0.01 = 1 %)");
   return tool.Run(argc, argv, [&] {
     jvl::sim::PriorOptions options = jvl::sim::PriorPreset(preset, seed);
-    if (yaw_drift >= 0) options.yaw_bias_deg_per_100m = yaw_drift;
-    if (scale_bias >= 0) options.scale_bias = scale_bias;
+    if (yaw_option->count() > 0) options.yaw_bias_deg_per_100m = yaw_drift;
+    if (scale_option->count() > 0) options.scale_bias = scale_bias;
     options.Check();
     tool.AddInput(gt_path);
     const jvl::Trajectory gt = jvl::io::ReadTrajectory(gt_path);

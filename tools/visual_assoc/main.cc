@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
     options.Check();
     auto dataset =
         io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
-    tool.SetDatasetId(dataset->id());
+    tool.SetDatasetId(dataset->id(), dataset_dir);
     for (const auto& f : dataset->KeyFiles()) tool.AddInput(f);
     const Trajectory prior = io::ReadTrajectory(prior_path);
     tool.AddInput(prior_path);

@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
                                               jvl::ParseFrameRange(frames));
     for (const std::string& f : dataset->KeyFiles()) tool.AddInput(f);
-    tool.SetDatasetId(dataset->id());
+    tool.SetDatasetId(dataset->id(), dataset_dir);
     const jvl::VpDetectRunResult result = jvl::RunVpDetect(*dataset, run);
     jvl::io::WriteVpsArtifact(output, result.data, tool.MakeProvenance());
     if (!csv.empty()) jvl::io::WriteVpsCsv(csv, result.data);

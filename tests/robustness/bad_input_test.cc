@@ -1,0 +1,543 @@
+// The bad-input matrix: every tool, run as a user runs it, on damaged datasets, damaged or
+// mismatched artifacts and invalid options. Each case either fails with exit code 1 or 2 and
+// exactly one "<tool>: error: ..." line on stderr naming the file, frame or option, or is a
+// documented fallback that exits 0 with a warning (docs/robustness.md lists them). A crash, a
+// hang (120 s) or a second error line fails the test.
+//
+// Inputs: the chain of run_a (robust_pipeline_a, 40 synthetic frames) and copies of its
+// sequence with one thing broken each, under <build>/tests/robustness/bad.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "io/artifact.h"
+#include "io/directions_io.h"
+#include "io/files.h"
+#include "io/local_io.h"
+#include "io/trajectory_io.h"
+#include "io/visual_io.h"
+#include "io/vps_io.h"
+
+namespace jvl {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kBin = std::string(JVL_BINARY_DIR) + "/bin/";
+const std::string kRun = std::string(JVL_BINARY_DIR) + "/tests/robustness/run_a";
+const std::string kBad = std::string(JVL_BINARY_DIR) + "/tests/robustness/bad";
+const std::string kSeq = kRun + "/data/sequences/00";
+
+struct Outcome {
+  int code = 0;
+  std::string err;
+};
+
+Outcome Run(const std::string& tool, const std::string& args) {
+  const std::string err_path = kBad + "/stderr.txt";
+  const std::string log = args.find("--log-level") == std::string::npos ? " --log-level warn" : "";
+  const std::string cmd = "timeout -k 5 120 " + kBin + tool + " " + args + " --quiet" + log +
+                          " > /dev/null 2> " + err_path;
+  const int status = std::system(cmd.c_str());
+  Outcome o;
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  o.err = io::ReadTextFile(err_path);
+  return o;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line))
+    if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+// Fails with exit code 1/2 and one error line that contains `expected`.
+void ExpectError(const std::string& tool, const std::string& args, const std::string& expected) {
+  const Outcome o = Run(tool, args);
+  const std::string what = tool + " " + args + "\nexit code " + std::to_string(o.code) +
+                           (o.code == 124  ? " (hang)"
+                            : o.code > 128 ? " (crash)"
+                                           : "") +
+                           "\nstderr:\n" + o.err;
+  EXPECT_TRUE(o.code == 1 || o.code == 2) << what;
+  std::vector<std::string> other;  // Lines that are not log lines ("[time] [level] ...").
+  for (const std::string& line : Lines(o.err))
+    if (line.front() != '[') other.push_back(line);
+  ASSERT_EQ(other.size(), 1u) << what;
+  std::printf("[error]   %s\n", other[0].c_str());  // The matrix, for docs/robustness.md.
+  EXPECT_EQ(other[0].rfind(tool + ": error: ", 0), 0u) << what;
+  EXPECT_NE(other[0].find(expected), std::string::npos) << "expected '" << expected << "' in\n"
+                                                        << what;
+}
+
+// A documented fallback: exit code 0 and a warning that contains `expected`.
+void ExpectWarning(const std::string& tool, const std::string& args, const std::string& expected) {
+  const Outcome o = Run(tool, args);
+  const std::string what =
+      tool + " " + args + "\nexit code " + std::to_string(o.code) + "\nstderr:\n" + o.err;
+  EXPECT_EQ(o.code, 0) << what;
+  bool found = false;
+  for (const std::string& line : Lines(o.err)) {
+    EXPECT_EQ(line.front(), '[') << "not a log line: " << line << "\n" << what;
+    if (line.find("[warning]") != std::string::npos && line.find(expected) != std::string::npos) {
+      if (!found) std::printf("[warning] %s: %s\n", tool.c_str(), line.c_str());
+      found = true;
+    }
+  }
+  EXPECT_TRUE(found) << "expected a warning with '" << expected << "' in\n" << what;
+}
+
+void WriteFile(const std::string& path, const std::string& content) {
+  fs::remove(path);
+  std::ofstream(path, std::ios::binary) << content;
+}
+
+std::string Head(const std::string& path, size_t bytes) {
+  return io::ReadTextFile(path).substr(0, bytes);
+}
+
+// <kBad>/<name>/00: the run's sequence as symbolic links (frames [0, frames)), so that one file
+// can be replaced. Its dataset id equals the original's (same folder name, calib and times).
+std::string Sequence(const std::string& name, int frames, const std::string& folder = "00") {
+  const std::string dir = kBad + "/" + name + "/" + folder;
+  fs::remove_all(dir);
+  for (const std::string sub : {"velodyne", "image_0"}) {
+    fs::create_directories(dir + "/" + sub);
+    for (int f = 0; f < frames; ++f) {
+      char file[32];
+      std::snprintf(file, sizeof(file), "/%06d.%s", f, sub == "velodyne" ? "bin" : "png");
+      fs::create_symlink(kSeq + "/" + sub + file, dir + "/" + sub + file);
+    }
+  }
+  fs::copy_file(kSeq + "/calib.txt", dir + "/calib.txt");
+  fs::copy_file(kSeq + "/times.txt", dir + "/times.txt");
+  return dir;
+}
+
+std::string Scan(const std::string& seq, int frame) {
+  char file[32];
+  std::snprintf(file, sizeof(file), "/velodyne/%06d.bin", frame);
+  return seq + file;
+}
+
+std::string Image(const std::string& seq, int frame) {
+  char file[32];
+  std::snprintf(file, sizeof(file), "/image_0/%06d.png", frame);
+  return seq + file;
+}
+
+std::string In(const std::string& name) { return kRun + "/" + name; }
+std::string Bad(const std::string& name) { return kBad + "/" + name; }
+
+io::Provenance WithDataset(const std::string& id) {
+  io::Provenance p;
+  p.tool = "bad_input_test";
+  p.dataset_id = id;
+  return p;
+}
+
+class BadInputTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!io::FileExists(In("global.h5"))) return;
+    fs::remove_all(kBad);
+    fs::create_directories(kBad);
+    id_ = io::ReadArtifactDatasetId(In("visual.h5"));
+    // A small chain (8 keyframes) for the stages whose fallbacks run to the end.
+    const std::string q = " --quiet --log-level warn --threads 1";
+    const std::string small = kBin + "visual_assoc --dataset " + kSeq + " --frames 0:8 --prior " +
+                              In("prior.h5") + " --directions " + In("directions.h5") + " -o " +
+                              Bad("visual8.h5") + q + " > /dev/null && " + kBin +
+                              "local_map --visual " + Bad("visual8.h5") + " --dataset " + kSeq +
+                              " -o " + Bad("local8.h5") + q + " > /dev/null";
+    ASSERT_EQ(std::system(small.c_str()), 0) << small;
+  }
+  void SetUp() override {
+    if (!io::FileExists(In("global.h5"))) GTEST_SKIP() << kRun << " incomplete (robust_pipeline_a)";
+  }
+  static std::string id_;
+};
+std::string BadInputTest::id_;
+
+TEST_F(BadInputTest, MissingAndDamagedDatasetFiles) {
+  for (const std::string tool : {"dataset_info", "lidar_odom", "vp_detect"}) {
+    const std::string out = tool == "dataset_info" ? "" : " -o " + Bad("x.h5");
+    ExpectError(tool, "--dataset " + Bad("no_such_folder") + out, "no_such_folder: dataset folder");
+  }
+  const std::string no_calib = Sequence("no_calib", 4);
+  fs::remove(no_calib + "/calib.txt");
+  ExpectError("lidar_odom", "--dataset " + no_calib + " -o " + Bad("x.h5"), "no_calib/00: unknown");
+
+  const std::string cut_calib = Sequence("cut_calib", 4);
+  WriteFile(cut_calib + "/calib.txt", Head(kSeq + "/calib.txt", 150));
+  ExpectError("vp_detect", "--dataset " + cut_calib + " -o " + Bad("x.h5"),
+              "calib.txt:1: P0 has 8 numbers, expected 12");
+  const std::string full = io::ReadTextFile(kSeq + "/calib.txt");
+  WriteFile(cut_calib + "/calib.txt", full.substr(0, full.find("P3:")));
+  ExpectError("visual_assoc",
+              "--dataset " + cut_calib + " --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+              "calib.txt: missing P3 (3x4 projection matrix)");
+
+  const std::string long_p0 = Sequence("long_p0", 4);
+  std::string calib = io::ReadTextFile(kSeq + "/calib.txt");
+  calib.replace(calib.find("P0: ") + 4, 0, "7 ");
+  WriteFile(long_p0 + "/calib.txt", calib);
+  ExpectError("dataset_info", "-d " + long_p0, "calib.txt:1: P0 has 13 numbers, expected 12");
+
+  const std::string nan_calib = Sequence("nan_calib", 4);
+  calib = io::ReadTextFile(kSeq + "/calib.txt");
+  const size_t first = calib.find("P0: ") + 4;
+  calib.replace(first, calib.find(' ', first) - first, "nan");
+  WriteFile(nan_calib + "/calib.txt", calib);
+  ExpectError("dataset_info", "-d " + nan_calib, "calib.txt:1: bad number 'nan");
+
+  const std::string zero_tr = Sequence("zero_tr", 4);
+  calib = io::ReadTextFile(kSeq + "/calib.txt");
+  calib = calib.substr(0, calib.find("Tr:")) + "Tr: 0 0 0 0 0 0 0 0 0 0 0 0\n";
+  WriteFile(zero_tr + "/calib.txt", calib);
+  ExpectError("lidar_odom", "--dataset " + zero_tr + " -o " + Bad("x.h5"),
+              "calib.txt: Tr is not a rigid transform");
+
+  const std::string cut_times = Sequence("cut_times", 4);
+  WriteFile(cut_times + "/times.txt", Head(kSeq + "/times.txt", 20));
+  ExpectError("visual_assoc",
+              "--dataset " + cut_times + " --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+              "times.txt: 2 timestamps but the sequence has frame 3");
+  const std::string bad_times = Sequence("bad_times", 4);
+  WriteFile(bad_times + "/times.txt", "0.0\n0.1\nabc\n0.3\n");
+  ExpectError("dataset_info", "-d " + bad_times, "times.txt:3: bad timestamp 'abc'");
+}
+
+TEST_F(BadInputTest, DamagedScans) {
+  const std::string odd = Sequence("odd_bin", 40);
+  WriteFile(Scan(odd, 3), Head(Scan(kSeq, 3), 16 * 1000 + 7));
+  ExpectError("lidar_odom", "--dataset " + odd + " --frames 0:5 -o " + Bad("x.h5"),
+              "000003.bin: size 16007 bytes is not a multiple of 16");
+  ExpectError("dataset_info", "-d " + odd + " --check-scans", "000003.bin: size 16007");
+  ExpectError("local_map",
+              "--visual " + Bad("visual8.h5") + " --dataset " + odd + " -o " + Bad("x.h5"),
+              "000003.bin: size 16007");
+
+  const std::string missing = Sequence("missing_bin", 40);
+  fs::remove(Scan(missing, 5));
+  ExpectError("local_map",
+              "--visual " + Bad("visual8.h5") + " --dataset " + missing + " -o " + Bad("x.h5"),
+              "000005.bin: missing scan for frame 5");
+
+  // Non-finite points are dropped with a warning; an empty scan keeps the motion model.
+  const std::string nonfinite = Sequence("nonfinite_bin", 40);
+  std::string bytes = io::ReadTextFile(Scan(kSeq, 2));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (size_t i = 0; i + 16 <= bytes.size(); i += 16 * 5) std::memcpy(&bytes[i], &nan, 4);
+  for (size_t i = 16 * 2; i + 16 <= bytes.size(); i += 16 * 7) std::memcpy(&bytes[i + 8], &inf, 4);
+  WriteFile(Scan(nonfinite, 2), bytes);
+  ExpectWarning("lidar_odom", "--dataset " + nonfinite + " --frames 0:5 -o " + Bad("x.h5"),
+                "000002.bin: dropped");
+  ExpectWarning("dataset_info", "-d " + nonfinite + " --check-scans", "non-finite points");
+  ExpectWarning("local_map",
+                "--visual " + Bad("visual8.h5") + " --dataset " + nonfinite + " -o " + Bad("x.h5"),
+                "000002.bin: dropped");
+
+  const std::string empty = Sequence("empty_bin", 40);
+  WriteFile(Scan(empty, 0), "");
+  WriteFile(Scan(empty, 3), "");
+  ExpectWarning("lidar_odom", "--dataset " + empty + " --frames 0:6 -o " + Bad("x.h5"),
+                "000003.bin: empty scan (frame 3)");
+  ExpectWarning("local_map",
+                "--visual " + Bad("visual8.h5") + " --dataset " + empty + " -o " + Bad("x.h5"),
+                "empty scan");
+}
+
+TEST_F(BadInputTest, DamagedImages) {
+  const std::string garbage = Sequence("garbage_png", 6);
+  WriteFile(Image(garbage, 2), "this is not an image");
+  ExpectError("vp_detect", "--dataset " + garbage + " -o " + Bad("x.h5"),
+              "000002.png: image does not decode");
+  ExpectError("visual_assoc",
+              "--dataset " + garbage + " --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+              "000002.png: image does not decode");
+
+  const std::string cut = Sequence("cut_png", 6);
+  WriteFile(Image(cut, 4), Head(Image(kSeq, 4), 5000));
+  ExpectError("vp_detect", "--dataset " + cut + " -o " + Bad("x.h5"), "000004.png: truncated PNG");
+  ExpectError("visual_assoc",
+              "--dataset " + cut + " --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+              "000004.png: truncated PNG");
+
+  const std::string missing = Sequence("missing_png", 6);
+  fs::remove(Image(missing, 1));
+  ExpectError("vp_detect", "--dataset " + missing + " -o " + Bad("x.h5"),
+              "000001.png: missing image of camera 0 for frame 1");
+
+  const std::string first_bad = Sequence("first_png", 3);
+  WriteFile(Image(first_bad, 0), "");
+  ExpectError("dataset_info", "-d " + first_bad, "000000.png: empty image file");
+}
+
+TEST_F(BadInputTest, TruncatedAndWrongArtifacts) {
+  for (const std::string a : {"prior.h5", "vps.h5", "directions.h5", "visual.h5", "local.h5"}) {
+    WriteFile(Bad("cut_" + a), Head(In(a), io::FileSize(In(a)) / 2));
+    WriteFile(Bad("empty_" + a), "");
+  }
+  const std::string dirs = " --directions " + In("directions.h5");
+  ExpectError("direction_cluster",
+              "--vps " + Bad("cut_vps.h5") + " --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+              "cut_vps.h5: cannot open HDF5 file");
+  ExpectError("direction_cluster",
+              "--vps " + In("vps.h5") + " --prior " + Bad("empty_prior.h5") + " -o " + Bad("x.h5"),
+              "empty_prior.h5: not an HDF5 file");
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --prior " + Bad("cut_prior.h5") + " -o " + Bad("x.h5"),
+              "cut_prior.h5: cannot open HDF5 file");
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --prior " + In("prior.h5") + " --directions " +
+                  Bad("cut_directions.h5") + " -o " + Bad("x.h5"),
+              "cut_directions.h5");
+  ExpectError("local_map",
+              "--visual " + Bad("cut_visual.h5") + " --dataset " + kSeq + " -o " + Bad("x.h5"),
+              "cut_visual.h5: cannot open HDF5 file");
+  ExpectError("global_opt",
+              "--local " + Bad("cut_local.h5") + " --visual " + In("visual.h5") + dirs + " -o " +
+                  Bad("x.h5"),
+              "cut_local.h5: cannot open");
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + Bad("empty_visual.h5") + dirs + " -o " +
+                  Bad("x.h5"),
+              "empty_visual.h5: not an HDF5 file");
+  ExpectError("evaluate", "--gt " + kRun + "/data/poses/00.txt --est " + Bad("cut_prior.h5"),
+              "cut_prior.h5: cannot open HDF5 file");
+  ExpectError("make_prior", "-g " + Bad("empty_prior.h5") + " -o " + Bad("x.h5"),
+              "empty_prior.h5: not an HDF5 file");
+
+  // Wrong schema name and wrong schema version.
+  ExpectError("local_map", "--visual " + In("vps.h5") + " --dataset " + kSeq + " -o " + Bad("x.h5"),
+              "vps.h5: expected schema 'visual' version 1, found 'vps' version 1");
+  ExpectError(
+      "global_opt",
+      "--local " + In("visual.h5") + " --visual " + In("visual.h5") + dirs + " -o " + Bad("x.h5"),
+      "expected schema 'local' version 1, found 'visual'");
+  ExpectError("direction_cluster",
+              "--vps " + In("directions.h5") + " --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+              "expected schema 'vps'");
+  ExpectError("evaluate", "--gt " + In("vps.h5") + " --est " + In("prior.h5"),
+              "vps.h5: artifact 'vps' holds no trajectory");
+  {
+    io::H5Writer w(Bad("visual_v2.h5"), "visual", 2);
+    w.Commit(WithDataset(id_));
+  }
+  ExpectError("local_map",
+              "--visual " + Bad("visual_v2.h5") + " --dataset " + kSeq + " -o " + Bad("x.h5"),
+              "expected schema 'visual' version 1, found 'visual' version 2");
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + Bad("visual_v2.h5") + dirs + " -o " +
+                  Bad("x.h5"),
+              "found 'visual' version 2");
+}
+
+TEST_F(BadInputTest, DamagedTrajectoryText) {
+  const std::string gt = kRun + "/data/poses/00.txt";
+  const std::string text = io::ReadTextFile(gt);
+  WriteFile(Bad("cut.txt"), text.substr(0, text.size() / 2 - 7));
+  WriteFile(Bad("nan.txt"), "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 nan 0 1 0 0 0 0 1 0\n");
+  WriteFile(Bad("empty.txt"), "");
+  WriteFile(Bad("scaled.txt"), "2 0 0 0 0 2 0 0 0 0 2 0\n");
+  WriteFile(Bad("tum_q.txt"), "0.0 0 0 0 0 0 0 2\n");
+  WriteFile(Bad("back.txt"), "5 1 0 0 0 0 1 0 0 0 0 1 0\n3 1 0 0 0 0 1 0 0 0 0 1 0\n");
+  ExpectError("make_prior", "-g " + Bad("cut.txt") + " -o " + Bad("x.h5"), "cut.txt:21: 4 columns");
+  ExpectError("make_prior", "-g " + Bad("nan.txt") + " -o " + Bad("x.h5"),
+              "nan.txt:2: bad number 'nan' in column 4");
+  ExpectError("evaluate", "--gt " + gt + " --est " + Bad("empty.txt"), "empty.txt: no poses found");
+  ExpectError("evaluate", "--gt " + Bad("scaled.txt") + " --est " + gt,
+              "scaled.txt:1: rotation part is not a rotation");
+  ExpectError("direction_cluster",
+              "--vps " + In("vps.h5") + " --prior " + Bad("tum_q.txt") + " -o " + Bad("x.h5"),
+              "tum_q.txt:1: quaternion is not unit");
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --prior " + Bad("back.txt") + " -o " + Bad("x.h5"),
+              "back.txt:2: frame 3 does not increase");
+  ExpectError("evaluate", "--gt " + gt + " --est " + Bad("missing.txt"),
+              "missing.txt: file not found");
+}
+
+TEST_F(BadInputTest, ArtifactsOfDifferentSequences) {
+  const std::string other_id = "kitti:01:0123abcd";
+  io::WriteVisualMap(Bad("visual_01.h5"), io::ReadVisualMap(In("visual.h5")),
+                     WithDataset(other_id));
+  io::WriteVpsArtifact(Bad("vps_01.h5"), io::ReadVpsArtifact(In("vps.h5")), WithDataset(other_id));
+  io::WriteDirectionsArtifact(Bad("directions_01.h5"),
+                              io::ReadDirectionsArtifact(In("directions.h5")),
+                              WithDataset(other_id));
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + Bad("visual_01.h5") + " --directions " +
+                  In("directions.h5") + " -o " + Bad("x.h5"),
+              "(inputs of different sequences)");
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + In("visual.h5") + " --directions " +
+                  Bad("directions_01.h5") + " -o " + Bad("x.h5"),
+              "directions_01.h5 was made from sequence 'kitti:01:0123abcd'");
+  ExpectError("direction_cluster",
+              "--vps " + Bad("vps_01.h5") + " --prior " + In("odom.h5") + " -o " + Bad("x.h5"),
+              "odom.h5 was made from sequence");
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --prior " + In("prior.h5") + " --directions " +
+                  Bad("directions_01.h5") + " -o " + Bad("x.h5"),
+              "directions_01.h5 was made from sequence 'kitti:01:0123abcd'");
+  // The same frames under another sequence name: local_map must not take them for run_a's.
+  const std::string renamed = Sequence("renamed", 40, "01");
+  ExpectError("local_map",
+              "--visual " + In("visual.h5") + " --dataset " + renamed + " -o " + Bad("x.h5"),
+              "(inputs of different sequences)");
+}
+
+TEST_F(BadInputTest, FrameRangesThatDoNotOverlap) {
+  ExpectError("dataset_info", "-d " + kSeq + " --frames 100:200",
+              "--frames 100:200 selects no frame of");
+  ExpectError("vp_detect", "--dataset " + kSeq + " --frames 50: -o " + Bad("x.h5"),
+              "--frames 50: selects no frame");
+  // A prior of frames 0-9 for frames 20-39.
+  Trajectory prior = io::ReadTrajectory(In("prior.h5"));
+  Trajectory first10;
+  for (size_t i = 0; i < 10; ++i) first10.Append(prior.frames[i], prior.world_from_cam[i]);
+  io::WriteTrajectoryKitti(Bad("prior_0_9.txt"), first10);
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --frames 20:40 --prior " + Bad("prior_0_9.txt") + " -o " +
+                  Bad("x.h5"),
+              "prior_0_9.txt");
+  ExpectError("local_map",
+              "--visual " + In("visual.h5") + " --dataset " + kSeq + " --prior " +
+                  Bad("prior_0_9.txt") + " -o " + Bad("x.h5"),
+              "prior_0_9.txt");
+  // Estimate and ground truth without a common frame.
+  Trajectory late;
+  for (size_t i = 20; i < prior.size(); ++i) late.Append(prior.frames[i], prior.world_from_cam[i]);
+  io::WriteTrajectoryKitti(Bad("prior_20_39.txt"), late);
+  ExpectError("evaluate", "--gt " + Bad("prior_0_9.txt") + " --est " + Bad("prior_20_39.txt"),
+              "prior_20_39.txt");
+  // VPs of frames the prior lacks are skipped with a warning.
+  ExpectWarning("direction_cluster",
+                "--vps " + In("vps.h5") + " --prior " + Bad("prior_0_9.txt") + " -o " + Bad("x.h5"),
+                "VPs skipped");
+}
+
+TEST_F(BadInputTest, EmptyContent) {
+  // Zero VPs: no direction priors, with a warning; downstream runs without them.
+  io::VpsData vps = io::ReadVpsArtifact(In("vps.h5"));
+  vps.vps.clear();
+  io::WriteVpsArtifact(Bad("vps_none.h5"), vps, WithDataset(id_));
+  ExpectWarning("direction_cluster",
+                "--vps " + Bad("vps_none.h5") + " --prior " + In("prior.h5") + " -o " +
+                    Bad("directions_none.h5"),
+                "no direction prior");
+  ExpectWarning("global_opt",
+                "--local " + Bad("local8.h5") + " --visual " + Bad("visual8.h5") +
+                    " --directions " + Bad("directions_none.h5") + " -o " + Bad("x.h5"),
+                "no direction prior");
+  // No keyframes.
+  io::VisualMapData visual = io::ReadVisualMap(Bad("visual8.h5"));
+  io::VisualMapData none = visual;
+  none.keyframes = Trajectory();
+  none.keypoint_keyframe.clear();
+  none.keypoint_uv.clear();
+  none.keypoint_octave.clear();
+  none.keypoint_angle.clear();
+  none.keypoint_descriptor.clear();
+  none.mappoint_position.clear();
+  none.mappoint_descriptor.clear();
+  none.mappoint_normal.clear();
+  none.observation_keyframe.clear();
+  none.observation_keypoint.clear();
+  none.observation_mappoint.clear();
+  none.covisibility_edges.clear();
+  none.covisibility_weight.clear();
+  io::WriteVisualMap(Bad("visual_none.h5"), none, WithDataset(id_));
+  ExpectError("local_map",
+              "--visual " + Bad("visual_none.h5") + " --dataset " + kSeq + " -o " + Bad("x.h5"),
+              "visual_none.h5: no keyframes");
+  ExpectError("global_opt",
+              "--local " + Bad("local8.h5") + " --visual " + Bad("visual_none.h5") +
+                  " --directions " + In("directions.h5") + " -o " + Bad("x.h5"),
+              "visual_none.h5: no keyframes");
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + Bad("visual8.h5") + " --directions " +
+                  In("directions.h5") + " -o " + Bad("x.h5"),
+              "visual8.h5 have different keyframes (40 vs 8)");
+  // A covisibility graph in two parts (keyframes 0-3 and 4-7 share no edge).
+  io::VisualMapData split = visual;
+  split.covisibility_edges.clear();
+  split.covisibility_weight.clear();
+  for (size_t e = 0; e < visual.num_edges(); ++e) {
+    const int32_t a = visual.covisibility_edges[2 * e], b = visual.covisibility_edges[2 * e + 1];
+    if ((a < 4) != (b < 4)) continue;
+    split.covisibility_edges.insert(split.covisibility_edges.end(), {a, b});
+    split.covisibility_weight.push_back(visual.covisibility_weight[e]);
+  }
+  io::WriteVisualMap(Bad("visual_split.h5"), split, WithDataset(id_));
+  ExpectWarning(
+      "local_map",
+      "--visual " + Bad("visual_split.h5") + " --dataset " + kSeq + " -o " + Bad("local_split.h5"),
+      "covisibility graph");
+  ExpectWarning("global_opt",
+                "--local " + Bad("local8.h5") + " --visual " + Bad("visual_split.h5") +
+                    " --directions " + In("directions.h5") + " -o " + Bad("x.h5"),
+                "covisibility graph");
+}
+
+TEST_F(BadInputTest, InvalidOptions) {
+  const std::string seq = " --dataset " + kSeq + " -o " + Bad("x.h5");
+  ExpectError("dataset_info", "-d " + kSeq + " --threads -2", "--threads must be >= 0");
+  ExpectError("dataset_info", "-d " + kSeq + " --frames 9:3", "--frames: end must be");
+  ExpectError("dataset_info", "-d " + kSeq + " --format kitti-odometry", "--format: unknown");
+  ExpectError("dataset_info", "-d " + kSeq + " --no-such-option", "--no-such-option");
+  ExpectError("sim_sequence", "-o " + Bad("sim") + " --sequence 1x",
+              "--sequence must be two digits");
+  ExpectError("sim_sequence", "-o " + Bad("sim") + " --frames 100000", "--frames 100000 exceeds");
+  ExpectError("sim_sequence", "-o " + Bad("sim") + " --scenario mars", "mars");
+  ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + Bad("x.h5") + " --preset bogus",
+              "unknown prior preset 'bogus'");
+  ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + Bad("x.h5") + " --yaw-drift nan",
+              "--yaw-drift");
+  ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + Bad("x.h5") + " --scale-bias 0.7",
+              "--scale-bias");
+  ExpectError("lidar_odom", seq + " --voxel-size -1", "voxel");
+  ExpectError("lidar_odom", seq + " --scan-map-size 0", "scan");
+  ExpectError("lidar_odom", seq + " --log-level loud", "--log-level: unknown level 'loud'");
+  ExpectError("vp_detect", seq + " --canny-low 0", "--canny-low");
+  ExpectError("vp_detect", seq + " --detector hough", "hough");
+  ExpectError("vp_detect", seq + " --line-scale 0", "line scale");
+  ExpectError(
+      "direction_cluster",
+      "--vps " + In("vps.h5") + " --prior " + In("prior.h5") + " -o " + Bad("x.h5") + " --up 0,0,0",
+      "--up");
+  ExpectError(
+      "direction_cluster",
+      "--vps " + In("vps.h5") + " --prior " + In("prior.h5") + " -o " + Bad("x.h5") + " --th-f 0",
+      "Th_f");
+  ExpectError("visual_assoc", seq + " --prior " + In("prior.h5") + " --orb-features 0", "orb");
+  ExpectError("local_map", "--visual " + In("visual.h5") + seq + " --alpha 0", "alpha");
+  ExpectError("local_map", "--visual " + In("visual.h5") + seq + " --samples-per-list 0",
+              "--samples-per-list");
+  const std::string global =
+      "--local " + In("local.h5") + " --visual " + In("visual.h5") + " -o " + Bad("x.h5");
+  ExpectError("global_opt", global, "--directions is required");
+  ExpectError("global_opt", global + " --no-direction --map-voxel 0.0001", "--map-voxel");
+  ExpectError("global_opt", global + " --no-direction --alpha nan", "alpha");
+  ExpectError("evaluate", "--gt " + In("prior.h5") + " --est " + In("odom.h5") + " --align best",
+              "best");
+  ExpectError("evaluate", "--gt " + In("prior.h5") + " --est " + In("odom.h5") + " --rpe-delta 0",
+              "--rpe-delta");
+  // An output that cannot be written: the message names it.
+  ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + kBad, "bad: cannot move");
+}
+
+}  // namespace
+}  // namespace jvl
