@@ -75,7 +75,9 @@ std::vector<int> Seeds(const std::vector<Eigen::Matrix<double, D, 1>>& points, d
   for (size_t i = 0; i < points.size(); ++i) {
     uint64_t key = 1469598103934665603ull;
     for (int d = 0; d < D; ++d)
-      key = (key ^ static_cast<uint64_t>(std::floor(points[i][d] / bin))) * 1099511628211ull;
+      // Through int64_t: a negative double converted to uint64_t directly is undefined.
+      key = (key ^ static_cast<uint64_t>(static_cast<int64_t>(std::floor(points[i][d] / bin)))) *
+            1099511628211ull;
     const auto [it, inserted] = index.emplace(key, int(seeds->size()));
     if (inserted) {
       seeds->push_back(Eigen::Matrix<double, D, 1>::Zero());

@@ -175,7 +175,9 @@ std::string ToString(Scenario scenario) {
   return "?";
 }
 
-std::vector<RoadPiece> ScenarioRoute(Scenario scenario) {
+namespace {
+
+std::vector<RoadPiece> ScenarioLap(Scenario scenario) {
   switch (scenario) {
     case Scenario::kUrban:
       // ~471 m: two long straights, three 90-degree corners, one gentle bend, an open stretch.
@@ -189,6 +191,20 @@ std::vector<RoadPiece> ScenarioRoute(Scenario scenario) {
               Turn(-15, 700, 20.0), Straight(200, 20.0)};
   }
   return {};
+}
+
+}  // namespace
+
+std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps) {
+  JVL_CHECK(laps >= 1 && laps <= 100, "--laps must be in [1, 100], got " << laps);
+  std::vector<RoadPiece> pieces;
+  for (int lap = 0; lap < laps; ++lap) {
+    for (RoadPiece p : ScenarioLap(scenario)) {
+      if (lap % 2 == 1) p.curvature = -p.curvature;
+      pieces.push_back(p);
+    }
+  }
+  return pieces;
 }
 
 void DriveOptions::Check() const {

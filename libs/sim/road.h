@@ -71,7 +71,9 @@ struct Terrain {
 enum class Scenario { kUrban, kSuburban, kHighway };
 Scenario ParseScenario(const std::string& name);  // urban|suburban|highway
 std::string ToString(Scenario scenario);
-std::vector<RoadPiece> ScenarioRoute(Scenario scenario);
+// `laps` > 1 repeats the pieces; every second lap has its turns mirrored (left <-> right), so
+// that the route zigzags on without crossing itself (urban: 9 laps = 4.3 km, 4779 frames).
+std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps = 1);
 
 struct DriveOptions {
   double frame_rate_hz = 10.0;

@@ -63,7 +63,7 @@ std::unique_ptr<World> BuildWorld(const SequenceOptions& options) {
   options.Check();
   auto world = std::make_unique<World>();
   world->options = options;
-  const Route route(ScenarioRoute(options.scenario), Eigen::Vector2d::Zero(), 0.35);
+  const Route route(ScenarioRoute(options.scenario, options.laps), Eigen::Vector2d::Zero(), 0.35);
   SceneOptions scene_options = options.scene;
   scene_options.scenario = options.scenario;
   scene_options.seed = options.seed;

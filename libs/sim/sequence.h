@@ -30,6 +30,7 @@ struct SequenceOptions {
   Scenario scenario = Scenario::kUrban;
   uint64_t seed = 1;
   int64_t frames = 0;          // 0: drive the whole route.
+  int laps = 1;                // Route repetitions (see ScenarioRoute), for long sequences.
   bool stop = false;           // Stop for a few seconds before the second corner.
   double lidar_height = 1.73;  // Velodyne above the road (KITTI setup).
   Calibration calibration = KittiCalibration();

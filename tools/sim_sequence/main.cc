@@ -27,6 +27,9 @@ int main(int argc, char** argv) {
   cli.add_option("--frames", opt.frames, "Frames to write (0 = whole route)")
       ->capture_default_str();
   cli.add_option("--scenario", scenario, "urban, suburban or highway")->capture_default_str();
+  cli.add_option("--laps", opt.laps,
+                 "Drive the route this many times, every second lap mirrored (long sequences)")
+      ->capture_default_str();
   cli.add_option("--seed", opt.seed, "Random seed (world layout and noise)")->capture_default_str();
   cli.add_flag("--stop", opt.stop, "Stop for a few seconds before the second corner");
   cli.add_option("--range-noise", opt.lidar.range_noise, "LiDAR range noise sigma (m)")
