@@ -8,8 +8,19 @@ if(JVL_SANITIZE)
   set(JVL_SANITIZER_FLAGS -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
 endif()
 
+# JVL_FUZZ: coverage instrumentation for libFuzzer in all project code (compile only; the fuzz
+# targets link the libFuzzer runtime, the other executables the sanitizer runtimes).
+set(JVL_FUZZ_FLAGS)
+if(JVL_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "JVL_FUZZ needs Clang: configure with CC=clang-14 CXX=clang++-14")
+  endif()
+  set(JVL_FUZZ_FLAGS -fsanitize=fuzzer-no-link)
+endif()
+
 function(jvl_apply_flags target)
-  target_compile_options(${target} PRIVATE ${JVL_WARNING_FLAGS} ${JVL_SANITIZER_FLAGS})
+  target_compile_options(${target} PRIVATE ${JVL_WARNING_FLAGS} ${JVL_SANITIZER_FLAGS}
+                         ${JVL_FUZZ_FLAGS})
   if(JVL_SANITIZE)
     target_link_options(${target} PRIVATE ${JVL_SANITIZER_FLAGS})
   endif()
@@ -66,4 +77,25 @@ function(jvl_add_benchmark)
   add_executable(${ARG_NAME} ${ARG_SOURCES})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} benchmark::benchmark)
   jvl_apply_flags(${ARG_NAME})
+endfunction()
+
+# jvl_add_fuzzer(NAME name SOURCES ... DEPS ... CORPUS dir [ARGS libFuzzer flags...]): a
+# libFuzzer target (JVL_FUZZ only) and a CTest entry "<name>_run" (label "fuzz") that fuzzes
+# for JVL_FUZZ_SECONDS from the committed seed corpus `dir`.
+set(JVL_FUZZ_SECONDS 15 CACHE STRING "Seconds per fuzz target in the CTest fuzz runs")
+function(jvl_add_fuzzer)
+  if(NOT JVL_FUZZ)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "NAME;CORPUS" "SOURCES;DEPS;ARGS" ${ARGN})
+  add_executable(${ARG_NAME} ${ARG_SOURCES})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS})
+  target_compile_definitions(${ARG_NAME} PRIVATE JVL_SOURCE_DIR="${CMAKE_SOURCE_DIR}")
+  jvl_apply_flags(${ARG_NAME})
+  target_link_options(${ARG_NAME} PRIVATE -fsanitize=fuzzer)
+  add_test(NAME ${ARG_NAME}_run
+    COMMAND ${CMAKE_SOURCE_DIR}/tests/fuzz/run_fuzzer.sh $<TARGET_FILE:${ARG_NAME}> ${ARG_CORPUS}
+            ${CMAKE_BINARY_DIR}/fuzz/${ARG_NAME} ${JVL_FUZZ_SECONDS} ${ARG_ARGS})
+  set_tests_properties(${ARG_NAME}_run PROPERTIES LABELS fuzz
+    TIMEOUT 300)
 endfunction()

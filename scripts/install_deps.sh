@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
 # Installs the build and runtime dependencies of JVLDLoc on Debian 12 (bookworm) or newer.
+# clang-14, its sanitizer/libFuzzer runtimes (libclang-rt-14-dev) and llvm-14 (llvm-symbolizer
+# for readable sanitizer reports) are for the sanitizer and fuzz build of scripts/test.sh.
 # Idempotent and non-interactive: packages already present are skipped.
 # Usage: sudo scripts/install_deps.sh   (or as root)
 set -euo pipefail
@@ -11,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev
   libopencv-contrib-dev libembree-dev
   python3 python3-matplotlib python3-numpy
+  clang-14 libclang-rt-14-dev llvm-14
 )
 
 missing=()

@@ -5,11 +5,12 @@
 
 #include <algorithm>
 #include <cstring>
-#include <optional>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 
 #include "core/check.h"
+#include "io/h5_probe.h"
 #include "io/version.h"
 
 namespace jvl::io {
@@ -94,15 +95,22 @@ void WriteStringAttribute(hid_t object, const std::string& name, const std::stri
             file << ": cannot write attribute '" << name << "'");
 }
 
+// Whether an attribute holds exactly one element (H5Aread writes every element into the buffer).
+bool IsScalarAttribute(hid_t attr) {
+  Handle space(H5Aget_space(attr), H5Sclose);
+  return space.ok() && H5Sget_simple_extent_npoints(space.get()) == 1;
+}
+
 std::optional<std::string> ReadStringAttribute(hid_t object, const std::string& name) {
   if (H5Aexists(object, name.c_str()) <= 0) return std::nullopt;
   Handle attr(H5Aopen(object, name.c_str(), H5P_DEFAULT), H5Aclose);
-  if (!attr.ok()) return std::nullopt;
+  if (!attr.ok() || !IsScalarAttribute(attr.get())) return std::nullopt;
   Handle type(H5Aget_type(attr.get()), H5Tclose);
   if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) > 0) {
     return std::nullopt;
   }
   const size_t size = H5Tget_size(type.get());
+  if (size > (size_t{1} << 28)) return std::nullopt;  // A damaged type; no attribute is this big.
   std::string value(size, '\0');
   if (H5Aread(attr.get(), type.get(), value.data()) < 0) return std::nullopt;
   value.resize(std::strlen(value.c_str()));
@@ -113,7 +121,10 @@ std::optional<int64_t> ReadIntAttribute(hid_t object, const std::string& name) {
   if (H5Aexists(object, name.c_str()) <= 0) return std::nullopt;
   Handle attr(H5Aopen(object, name.c_str(), H5P_DEFAULT), H5Aclose);
   int64_t value = 0;
-  if (!attr.ok() || H5Aread(attr.get(), H5T_NATIVE_INT64, &value) < 0) return std::nullopt;
+  if (!attr.ok() || !IsScalarAttribute(attr.get()) ||
+      H5Aread(attr.get(), H5T_NATIVE_INT64, &value) < 0) {
+    return std::nullopt;
+  }
   return value;
 }
 
@@ -183,13 +194,23 @@ H5Writer::H5Writer(std::string path, std::string schema, int schema_version)
   H5Pset_obj_track_times(fcpl.get(), 0);
   impl_->file = H5Fcreate(impl_->tmp.c_str(), H5F_ACC_TRUNC, fcpl.get(), H5P_DEFAULT);
   JVL_CHECK(impl_->file >= 0, impl_->tmp << ": cannot create HDF5 file");
-  WriteStringAttribute(impl_->file, kSchemaAttr, impl_->schema, impl_->path);
-  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-  Handle attr(H5Acreate2(impl_->file, kVersionAttr, H5T_STD_I64LE, space.get(), H5P_DEFAULT,
-                         H5P_DEFAULT),
-              H5Aclose);
-  const int64_t v = schema_version;
-  H5Awrite(attr.get(), H5T_NATIVE_INT64, &v);
+  try {
+    WriteStringAttribute(impl_->file, kSchemaAttr, impl_->schema, impl_->path);
+    Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+    Handle attr(
+        H5Acreate2(impl_->file, kVersionAttr, H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+        H5Aclose);
+    const int64_t v = schema_version;
+    JVL_CHECK(attr.ok() && H5Awrite(attr.get(), H5T_NATIVE_INT64, &v) >= 0,
+              impl_->path << ": cannot write the schema version");
+  } catch (...) {
+    // No destructor runs for a constructor that throws: close and remove here.
+    H5Fclose(impl_->file);
+    impl_->file = -1;
+    std::error_code ec;
+    std::filesystem::remove(impl_->tmp, ec);
+    throw;
+  }
 }
 
 H5Writer::~H5Writer() {
@@ -287,8 +308,23 @@ H5Reader::H5Reader(std::string path, const std::string& schema, int schema_versi
   const std::string& p = impl_->path;
   JVL_CHECK(FileExists(p), p << ": file not found");
   JVL_CHECK(H5Fis_hdf5(p.c_str()) > 0, p << ": not an HDF5 file (or truncated)");
+  JVL_CHECK(Hdf5MetadataWalkSurvives(p),
+            p << ": damaged HDF5 file (the HDF5 library crashes reading its metadata)");
   impl_->file = H5Fopen(p.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   JVL_CHECK(impl_->file >= 0, p << ": cannot open HDF5 file (truncated or damaged?)");
+  try {
+    CheckSchema(schema, schema_version);
+  } catch (...) {
+    // No destructor runs for a constructor that throws; a file left open would also make a
+    // later open of the same path see this file's cached metadata.
+    H5Fclose(impl_->file);
+    impl_->file = -1;
+    throw;
+  }
+}
+
+void H5Reader::CheckSchema(const std::string& schema, int schema_version) {
+  const std::string& p = impl_->path;
   const auto found_schema = ReadStringAttribute(impl_->file, kSchemaAttr);
   const auto found_version = ReadIntAttribute(impl_->file, kVersionAttr);
   JVL_CHECK(found_schema && found_version,
@@ -388,8 +424,16 @@ std::vector<T> H5Reader::ReadArray(const std::string& name, int64_t expected_col
     JVL_CHECK(dims.size() == 2 && dims[1] == expected_cols,
               impl_->path << ": dataset '" << name << "' should be N x " << expected_cols);
   }
+  // A damaged file can declare any shape. A real one stores every value (no fill values), at
+  // most ~1032 per byte with deflate, so larger shapes are rejected before allocating.
+  const int64_t limit = 1100 * (FileSize(impl_->path) + 4096);
   int64_t count = 1;
-  for (int64_t d : dims) count *= d;
+  for (int64_t d : dims) {
+    JVL_CHECK(d == 0 || count <= limit / d,
+              impl_->path << ": dataset '" << name
+                          << "' declares more values than the file can hold (damaged file?)");
+    count *= d;
+  }
   std::vector<T> out(static_cast<size_t>(count));
   if (count == 0) return out;
   Handle ds(H5Dopen2(impl_->file, name.c_str(), H5P_DEFAULT), H5Dclose);

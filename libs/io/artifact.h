@@ -89,6 +89,7 @@ class H5Reader {
   const std::string& path() const;
 
  private:
+  void CheckSchema(const std::string& schema, int schema_version);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,14 +1,17 @@
 #include "io/artifact.h"
 
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "core/check.h"
 #include "io/files.h"
+#include "io/local_io.h"
 #include "io/schema_check.h"
 #include "io/trajectory_io.h"
+#include "io/vps_io.h"
 
 namespace jvl::io {
 namespace {
@@ -92,6 +95,28 @@ TEST_F(ArtifactTest, NotHdf5AndTruncatedFilesAreRejected) {
   EXPECT_THROW(ReadTrajectory(Path("cut.h5")), Error);
   EXPECT_NE(ErrorOf([&] { H5Reader(Path("none.h5"), "x", 1); }).find("not found"),
             std::string::npos);
+}
+
+TEST_F(ArtifactTest, RejectedFileIsClosed) {
+  // A reader whose constructor throws (wrong schema) must not leave the file open.
+  WriteTrajectoryArtifact(Path("a.h5"), Small(), Provenance{});
+  EXPECT_THROW(H5Reader(Path("a.h5"), "visual", 1), Error);
+  EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_FILE), 0);
+  {
+    H5Reader r(Path("a.h5"), "trajectory", 1);
+    EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_FILE), 1);
+  }
+  EXPECT_EQ(H5Fget_obj_count(H5F_OBJ_ALL, H5F_OBJ_FILE), 0);
+}
+
+TEST_F(ArtifactTest, DamagedFilesFoundByFuzzingRaiseErrors) {
+  // Inputs of tests/fuzz/corpus/artifact that once crashed: a NaN image size (undefined
+  // conversion to int), metadata libhdf5 crashes on (caught by the metadata probe, or by the
+  // readers' checks where the library survives), a dataset shape of ~40 GB.
+  const std::string dir = std::string(JVL_SOURCE_DIR) + "/tests/fuzz/corpus/artifact/";
+  EXPECT_THROW(ReadVpsArtifact(dir + "regression_nan_image_size.h5"), Error);
+  EXPECT_THROW(ReadLocalMap(dir + "regression_hdf5_crash_local.h5"), Error);
+  EXPECT_THROW(ReadVpsArtifact(dir + "regression_hdf5_huge_alloc.h5"), Error);
 }
 
 TEST_F(ArtifactTest, UncommittedWriterLeavesPreviousArtifactIntact) {

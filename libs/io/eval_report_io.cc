@@ -54,7 +54,7 @@ PoseMatrices ParsePoseMatricesKitti(std::istream& in, const std::string& name) {
     const size_t off = tokens.size() - 12;
     int64_t frame = static_cast<int64_t>(m.frames.size());
     if (off == 1) {
-      JVL_CHECK(v[0] >= 0 && v[0] == std::floor(v[0]),
+      JVL_CHECK(v[0] >= 0 && v[0] < 1e15 && v[0] == std::floor(v[0]),
                 name << ":" << line_no << ": frame index '" << tokens[0] << "' is not an integer");
       frame = static_cast<int64_t>(v[0]);
     }
