@@ -11,6 +11,7 @@
 #include "io/local_io.h"
 #include "io/schema_check.h"
 #include "io/trajectory_io.h"
+#include "io/visual_io.h"
 #include "io/vps_io.h"
 
 namespace jvl::io {
@@ -117,6 +118,8 @@ TEST_F(ArtifactTest, DamagedFilesFoundByFuzzingRaiseErrors) {
   EXPECT_THROW(ReadVpsArtifact(dir + "regression_nan_image_size.h5"), Error);
   EXPECT_THROW(ReadLocalMap(dir + "regression_hdf5_crash_local.h5"), Error);
   EXPECT_THROW(ReadVpsArtifact(dir + "regression_hdf5_huge_alloc.h5"), Error);
+  // A visual map whose 'orb' attribute lost scale_factor (was a JSON exception, not an Error).
+  EXPECT_THROW(ReadVisualMap(dir + "regression_visual_orb_json.h5"), Error);
 }
 
 TEST_F(ArtifactTest, UncommittedWriterLeavesPreviousArtifactIntact) {

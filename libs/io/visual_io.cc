@@ -1,5 +1,7 @@
 #include "io/visual_io.h"
 
+#include <cmath>
+
 #include "core/check.h"
 #include "io/camera_io.h"
 #include "io/trajectory_io.h"
@@ -108,8 +110,15 @@ VisualMapData ReadVisualMap(const std::string& path) {
   VisualMapData d;
   d.camera = ReadCameraArray(r, "camera");
   const nlohmann::json orb = r.ReadJson("orb");
-  d.scale_factor = orb.at("scale_factor").get<double>();
-  d.num_levels = orb.at("num_levels").get<int>();
+  JVL_CHECK(orb.is_object() && orb.contains("scale_factor") && orb["scale_factor"].is_number() &&
+                orb.contains("num_levels") && orb["num_levels"].is_number_integer(),
+            path << ": attribute 'orb' lacks a numeric scale_factor / integer num_levels");
+  d.scale_factor = orb["scale_factor"].get<double>();
+  d.num_levels = orb["num_levels"].get<int>();
+  JVL_CHECK(std::isfinite(d.scale_factor) && d.scale_factor > 1.0 && d.scale_factor < 2.0 &&
+                d.num_levels >= 1 && d.num_levels <= 32,
+            path << ": attribute 'orb' has scale_factor " << d.scale_factor << " and num_levels "
+                 << d.num_levels << " (expected in (1, 2) and 1..32)");
   d.keyframes = ReadTrajectoryGroup(r, "keyframes");
   d.keypoint_keyframe = r.ReadArray<int32_t>("keypoints/keyframe");
   d.keypoint_uv = r.ReadArray<float>("keypoints/uv", 2);
