@@ -6,7 +6,19 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <string>
+
+#if defined(__SANITIZE_ADDRESS__)
+#define JVL_H5_PROBE_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(undefined_behavior_sanitizer)
+#define JVL_H5_PROBE_SANITIZED 1
+#endif
+#endif
+#if JVL_H5_PROBE_SANITIZED
+#include <sanitizer/common_interface_defs.h>
+#endif
 
 namespace jvl::io {
 namespace {
@@ -65,9 +77,15 @@ bool Hdf5MetadataWalkSurvives(const std::string& path) {
   const pid_t pid = ::fork();
   if (pid < 0) return true;  // No child: read without the probe.
   if (pid == 0) {
-    // The child only walks the file; a crash report of its own (sanitizer builds) is noise.
+    // The child only walks the file; a crash report of its own (sanitizer builds) is noise,
+    // and so are crash handlers inherited from the parent (a libFuzzer parent's would write a
+    // crash-* file for every damaged input the probe catches): die with the default action.
     const int null = ::open("/dev/null", O_WRONLY);
     if (null >= 0) ::dup2(null, STDERR_FILENO);
+    for (const int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) std::signal(sig, SIG_DFL);
+#if JVL_H5_PROBE_SANITIZED
+    __sanitizer_set_death_callback(nullptr);  // libFuzzer's writes a crash-* file on a report
+#endif
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     if (file >= 0) {
