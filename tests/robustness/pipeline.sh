@@ -25,6 +25,10 @@ seq=data/sequences/00
   "${common[@]}"
 "$bin/visual_assoc" --dataset "$seq" --prior prior.h5 --directions directions.h5 -o visual.h5 \
   --quiet "${common[@]}" > /dev/null
+# Distances of the map points to the simulated surfaces (checks that the tool accepts the
+# stages' artifacts of a simulated sequence; the prior's pose errors are part of the figures).
+"$bin/sim_map_check" --sequence "$seq" --visual visual.h5 --json map_check.json \
+  "${common[@]}" > /dev/null
 "$bin/local_map" --visual visual.h5 --dataset "$seq" -o local.h5 --kitti-poses local.txt --quiet \
   "${common[@]}" > /dev/null
 "$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 -o global.h5 \

@@ -8,6 +8,7 @@
 
 #include "app/tool.h"
 #include "io/artifact.h"
+#include "io/dataset.h"
 #include "io/files.h"
 #include "io/visual_io.h"
 #include "map_check_run.h"
@@ -45,7 +46,11 @@ int main(int argc, char** argv) {
     options.depth_bins.push_back(options.max_depth);
     options.Check();
     const auto world = jvl::tools::RebuildSequenceWorld(sequence_dir);
-    tool.AddInput(sequence_dir + "/sim/scene.json");
+    // scene.json names the simulated world ('sim:<scenario>:<seed>'), not the dataset id the
+    // stages record (from the folder's calib.txt and times.txt): the visual map is checked
+    // against the latter.
+    tool.SetDatasetId(jvl::io::OpenDataset(sequence_dir)->id(), sequence_dir);
+    tool.AddInput(sequence_dir + "/sim/scene.json", /*same_dataset=*/false);
     const jvl::io::VisualMapData visual = jvl::io::ReadVisualMap(visual_path);
     tool.AddInput(visual_path);
     const auto result = jvl::tools::RunMapCheck(*world, visual, options, tool.threads());
