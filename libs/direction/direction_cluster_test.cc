@@ -265,9 +265,10 @@ TEST(DirectionCluster, RejectsBadOptions) {
 namespace jvl::direction {
 namespace {
 
-TEST(DirectionCluster, FiveThousandFramesWithinBudget) {
-  // Straight runs of 150-450 m joined by 90 deg turns, 5000 frames 1 m apart (see also
-  // direction_benchmark); the budget is 5 s for 5000 frames.
+TEST(DirectionCluster, FiveThousandFrames) {
+  // Straight runs of 150-450 m joined by 90 deg turns, 5000 frames 1 m apart. The time budget
+  // (5 s for 5000 frames) is measured by direction_benchmark, not asserted here: a sanitizer
+  // build on a loaded machine is several times slower. This checks the result at that size.
   std::vector<testing::PathSegment> segments;
   for (int i = 0; segments.size() < 32; ++i) {
     segments.push_back({150.0 + 100.0 * (i % 4), 0});
@@ -281,7 +282,10 @@ TEST(DirectionCluster, FiveThousandFramesWithinBudget) {
   const double seconds = timer.ElapsedSeconds();
   std::printf("%zu frames, %zu VPs: %.3f s, %zu clusters, %zu associations\n", path.truth.size(),
               vps.size(), seconds, r.clusters.size(), r.associations.size());
-  EXPECT_LT(seconds, 5.0);
+  // One direction prior per straight run (16 here), and most frames of the runs associated.
+  EXPECT_EQ(r.clusters.size(), 16u);
+  EXPECT_GT(r.associations.size(), vps.size() / 3);
+  for (const auto& c : r.clusters) EXPECT_LT(c.std_deg, 1.0) << "cluster " << c.id;
 }
 
 }  // namespace
