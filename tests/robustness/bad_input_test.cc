@@ -218,20 +218,20 @@ TEST_F(BadInputTest, MissingAndDamagedDatasetFiles) {
 }
 
 TEST_F(BadInputTest, DamagedScans) {
+  // local_map on the 8-keyframe visual map of kSeq, reading the scans of `dir`.
+  const auto local_map_on = [&](const std::string& dir) {
+    return "--visual " + Bad("visual8.h5") + " --dataset " + dir + " -o " + Bad("x.h5");
+  };
   const std::string odd = Sequence("odd_bin", 40);
   WriteFile(Scan(odd, 3), Head(Scan(kSeq, 3), 16 * 1000 + 7));
   ExpectError("lidar_odom", "--dataset " + odd + " --frames 0:5 -o " + Bad("x.h5"),
               "000003.bin: size 16007 bytes is not a multiple of 16");
   ExpectError("dataset_info", "-d " + odd + " --check-scans", "000003.bin: size 16007");
-  ExpectError("local_map",
-              "--visual " + Bad("visual8.h5") + " --dataset " + odd + " -o " + Bad("x.h5"),
-              "000003.bin: size 16007");
+  ExpectError("local_map", local_map_on(odd), "000003.bin: size 16007");
 
   const std::string missing = Sequence("missing_bin", 40);
   fs::remove(Scan(missing, 5));
-  ExpectError("local_map",
-              "--visual " + Bad("visual8.h5") + " --dataset " + missing + " -o " + Bad("x.h5"),
-              "000005.bin: missing scan for frame 5");
+  ExpectError("local_map", local_map_on(missing), "000005.bin: missing scan for frame 5");
 
   // Non-finite points are dropped with a warning; an empty scan keeps the motion model.
   const std::string nonfinite = Sequence("nonfinite_bin", 40);
@@ -244,18 +244,14 @@ TEST_F(BadInputTest, DamagedScans) {
   ExpectWarning("lidar_odom", "--dataset " + nonfinite + " --frames 0:5 -o " + Bad("x.h5"),
                 "000002.bin: dropped");
   ExpectWarning("dataset_info", "-d " + nonfinite + " --check-scans", "non-finite points");
-  ExpectWarning("local_map",
-                "--visual " + Bad("visual8.h5") + " --dataset " + nonfinite + " -o " + Bad("x.h5"),
-                "000002.bin: dropped");
+  ExpectWarning("local_map", local_map_on(nonfinite), "000002.bin: dropped");
 
   const std::string empty = Sequence("empty_bin", 40);
   WriteFile(Scan(empty, 0), "");
   WriteFile(Scan(empty, 3), "");
   ExpectWarning("lidar_odom", "--dataset " + empty + " --frames 0:6 -o " + Bad("x.h5"),
                 "000003.bin: empty scan (frame 3)");
-  ExpectWarning("local_map",
-                "--visual " + Bad("visual8.h5") + " --dataset " + empty + " -o " + Bad("x.h5"),
-                "empty scan");
+  ExpectWarning("local_map", local_map_on(empty), "empty scan");
 }
 
 TEST_F(BadInputTest, DamagedImages) {
