@@ -51,6 +51,9 @@ void GlobalMapInput::Check() const {
   for (const auto& l : saved_imls)
     JVL_CHECK(l.n >= 0 && l.n < k && l.c >= 0 && l.c < k,
               "IMLS correspondence (" << l.n << ", " << l.c << ") out of range");
+  for (const auto& p : saved_imls_pairs)
+    JVL_CHECK(p.n >= 0 && p.n < k && p.c >= 0 && p.c < k,
+              "IMLS pair (" << p.n << ", " << p.c << ") out of range");
 }
 
 void ImlsTraversalOptions::Check() const {
@@ -276,19 +279,35 @@ std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
   JVL_CHECK(scans.size() == keyframes.size(),
             "TraverseImls: " << scans.size() << " scans for " << keyframes.size() << " keyframes");
   // The model of keyframe n holds the scans of keyframes ModelStart(n)..n-1 at the current
-  // poses; consecutive keyframes share most of it, so it slides (each scan is added once).
-  lidar::ImlsModel model(options.search_radius);
+  // poses; consecutive keyframes share most of it, so it slides (each scan is added once). The
+  // keyframes are cut into fixed chunks that run in parallel, each sliding its own model from
+  // the chunk's first keyframe; the chunks do not depend on the thread count, so neither does
+  // the result.
+  constexpr size_t kChunk = 64;
+  const size_t k = keyframes.size();
+  const size_t chunks = k > 1 ? (k - 1 + kChunk - 1) / kChunk : 0;
+  std::vector<std::vector<optim::ImlsCorrespondence>> parts(chunks);
+  ParallelFor(static_cast<int64_t>(chunks), ResolveThreadCount(threads), [&](int64_t chunk) {
+    lidar::ImlsModel model(options.search_radius);
+    const size_t first = 1 + static_cast<size_t>(chunk) * kChunk;
+    const size_t last = std::min(k, first + kChunk);
+    size_t next = 0;  // next scan to add
+    for (size_t n = first; n < last; ++n) {
+      const size_t start = ModelStart(keyframes, n, options.scan_map_frames);
+      for (const int64_t id : model.scan_ids())
+        if (static_cast<size_t>(id) < start) model.RemoveScan(id);
+      for (next = std::max(next, start); next < n; ++next)
+        AddToModel(keyframes, scans, next, &model);
+      auto l = TraverseKeyframe(keyframes, scans, n, model, options, 1);
+      parts[static_cast<size_t>(chunk)].insert(parts[static_cast<size_t>(chunk)].end(), l.begin(),
+                                               l.end());
+    }
+  });
   std::vector<optim::ImlsCorrespondence> out;
-  const int workers = ResolveThreadCount(threads);
-  size_t next = 0;  // next scan to add
-  for (size_t n = 1; n < keyframes.size(); ++n) {
-    const size_t start = ModelStart(keyframes, n, options.scan_map_frames);
-    for (const int64_t id : model.scan_ids())
-      if (static_cast<size_t>(id) < start) model.RemoveScan(id);
-    for (next = std::max(next, start); next < n; ++next) AddToModel(keyframes, scans, next, &model);
-    const auto l = TraverseKeyframe(keyframes, scans, n, model, options, workers);
-    out.insert(out.end(), l.begin(), l.end());
-  }
+  size_t total = 0;
+  for (const auto& part : parts) total += part.size();
+  out.reserve(total);
+  for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
   return out;
 }
 
@@ -353,6 +372,21 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   bool refitted = false;
   optim::JointProblemOptions joint = options.joint;  // direction sigma set once e_D enters
   optim::JointCostBreakdown first_before;
+  // The saved set L does not change between rounds: summed per keyframe pair once (exact, see
+  // optim/imls_pair_cost.h) instead of copying millions of correspondences into every round.
+  const bool summed_saved =
+      options.use_saved_imls && options.joint.compress_imls && options.joint.imls_huber <= 0;
+  JVL_CHECK(input.saved_imls_pairs.empty() || !options.use_saved_imls || summed_saved,
+            "the saved IMLS set is given summed per keyframe pair, which needs the compressed "
+            "e_L form (no Huber kernel on e_L)");
+  std::vector<optim::ImlsPair> saved_pairs;
+  if (summed_saved) {
+    saved_pairs = optim::AggregateImls(input.saved_imls);
+    saved_pairs.insert(saved_pairs.end(), input.saved_imls_pairs.begin(),
+                       input.saved_imls_pairs.end());
+  }
+  int64_t saved_count = static_cast<int64_t>(input.saved_imls.size());
+  for (const auto& p : input.saved_imls_pairs) saved_count += p.sum.count();
   for (int round = 0; round < rounds; ++round) {
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
@@ -383,8 +417,15 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
       problem.free_directions = free_directions;
     }
     problem.imls.clear();
-    if (options.use_saved_imls) problem.imls = input.saved_imls;
-    result.saved_imls = static_cast<int64_t>(problem.imls.size());
+    problem.imls_pairs.clear();
+    if (options.use_saved_imls) {
+      if (summed_saved) {
+        problem.imls_pairs = saved_pairs;
+      } else {
+        problem.imls = input.saved_imls;
+      }
+      result.saved_imls = saved_count;
+    }
     if (fresh) {
       // Eq. (3) against the current poses (the paper's single traversal in round 0).
       const Timer t;
@@ -394,17 +435,42 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
       result.fresh_imls = static_cast<int64_t>(l.size());
       result.traversal_time_s += t.ElapsedSeconds();
     }
-    if (round == 0 && options.use_directions && problem.directions.empty()) {
-      // Warm-start round without e_D: report the full energy at the input poses anyway.
-      optim::JointProblemInput full = problem;
-      full.directions = dirs.constraints;
-      auto built = optim::BuildJointProblem(full, joint);
-      first_before = optim::EvaluateJointCost(built, options.solve.threads);
+    // Warm-start round without e_D: the report's "before" is still the full energy at the input
+    // poses. Its visual and IMLS parts are this round's; e_D's part is evaluated on its own with
+    // the weights the full problem would have (no second copy of the large terms).
+    const bool add_direction_before =
+        round == 0 && options.use_directions && problem.directions.empty() &&
+        !dirs.constraints.empty();
+    optim::ResidualStats direction_before;
+    if (add_direction_before) {
+      optim::JointProblemInput only;
+      only.camera = problem.camera;
+      only.poses = problem.poses;
+      only.fixed = problem.fixed;
+      only.directions = dirs.constraints;
+      const optim::JointWeights w = optim::ResolveWeights(
+          joint, static_cast<int64_t>(problem.observations.size()),
+          optim::CountImls(problem), static_cast<int64_t>(dirs.constraints.size()));
+      optim::JointProblemOptions o = joint;
+      o.alpha = w.alpha;
+      o.beta = w.beta;
+      o.gamma = w.gamma;
+      auto built = optim::BuildJointProblem(only, o);
+      direction_before = optim::EvaluateJointCost(built, options.solve.threads).direction;
     }
-    result.solve = optim::OptimizeJoint(problem, joint, options.solve);
+    optim::SolveOptions solve = options.solve;
+    if (!solve.progress_label.empty())
+      solve.progress_label += " round " + std::to_string(round + 1) + "/" + std::to_string(rounds);
+    result.solve = optim::OptimizeJoint(problem, joint, solve);
     ++result.rounds;
     result.total_iterations += result.solve.iterations;
-    if (round == 0 && first_before.total == 0.0) first_before = result.solve.before;
+    if (round == 0) {
+      first_before = result.solve.before;
+      if (add_direction_before) {
+        first_before.direction = direction_before;
+        first_before.total += direction_before.cost;
+      }
+    }
     if (!result.solve.usable) {
       spdlog::warn(
           "global optimisation round {} failed ({}); keyframes keep the poses of the "

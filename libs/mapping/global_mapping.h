@@ -46,6 +46,10 @@ struct GlobalMapInput {
   std::vector<Eigen::Vector3d> map_points;             // World.
   std::vector<optim::VisualObservation> observations;  // keyframe = row.
   std::vector<optim::ImlsCorrespondence> saved_imls;   // The set L; n, c = rows.
+  // (Part of) the set L already summed per keyframe pair (optim::AggregateImls; n, c = rows): the
+  // compact form a caller may pass instead of millions of correspondences. Needs the compressed
+  // e_L form (JointProblemOptions::compress_imls, no Huber kernel on e_L).
+  std::vector<optim::ImlsPair> saved_imls_pairs;
   std::vector<KeyframeScan> scans;                     // One per keyframe row (may be empty).
   std::vector<DirectionAssociation> directions;        // Any frames; non-keyframes skipped.
   void Check() const;

@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 
+#include "optim/cost_functions.h"
+
 namespace jvl::optim {
 namespace {
 
@@ -33,6 +35,38 @@ Eigen::Matrix<double, 3, 4> RotateJacobian(const double* q_xyzw, const Eigen::Ve
 
 Eigen::Matrix<double, 3, 4> InverseRotateJacobian(const double* q_xyzw, const Eigen::Vector3d& v) {
   return RotateJacobianSigned(q_xyzw, v, -1.0);
+}
+
+// x_c = R_wc^T (X - t_wc), r = s (uv - pi(x_c)). dr/dx_c = -s [fx/z 0 -fx x/z^2; 0 fy/z -fy y/z^2];
+// dx_c/dq = d(R^T d)/dq with d = X - t_wc, dx_c/dt_wc = -R_wc^T, dx_c/dX = R_wc^T.
+bool VisualReprojectionAnalyticCost::Evaluate(double const* const* parameters, double* residuals,
+                                              double** jacobians) const {
+  const double* pose = parameters[0];
+  const Eigen::Map<const Eigen::Quaterniond> q_wc(pose);
+  const Eigen::Map<const Eigen::Vector3d> t_wc(pose + 4);
+  const Eigen::Map<const Eigen::Vector3d> x_w(parameters[1]);
+  const Eigen::Vector3d d = x_w - t_wc;
+  const Eigen::Vector3d x_c = q_wc.conjugate() * d;
+  if (!(x_c.z() > VisualReprojectionCost::kMinDepth)) return false;
+  const double inv_z = 1.0 / x_c.z();
+  const double s = sqrt_information_;
+  residuals[0] = s * (uv_.x() - (fx_ * x_c.x() * inv_z + cx_));
+  residuals[1] = s * (uv_.y() - (fy_ * x_c.y() * inv_z + cy_));
+  if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) return true;
+  Eigen::Matrix<double, 2, 3> dr_dx;
+  dr_dx << -s * fx_ * inv_z, 0, s * fx_ * x_c.x() * inv_z * inv_z,  //
+      0, -s * fy_ * inv_z, s * fy_ * x_c.y() * inv_z * inv_z;
+  const Eigen::Matrix<double, 2, 3> dr_dx_rt = dr_dx * q_wc.conjugate().toRotationMatrix();
+  if (jacobians[0] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jacobians[0]);
+    j.leftCols<4>() = dr_dx * InverseRotateJacobian(pose, d);
+    j.rightCols<3>() = -dr_dx_rt;
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
+    j = dr_dx_rt;
+  }
+  return true;
 }
 
 // r = s (n . R_wc^T (p_w - t_wc) - n . c_p_y) = s (g . (p_w - t_wc) - n . c_p_y), g = R_wc n,

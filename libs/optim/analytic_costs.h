@@ -21,6 +21,28 @@ Eigen::Matrix<double, 3, 4> RotateJacobian(const double* q_xyzw, const Eigen::Ve
 // d(R(q)^T v)/d[qx qy qz qw].
 Eigen::Matrix<double, 3, 4> InverseRotateJacobian(const double* q_xyzw, const Eigen::Vector3d& v);
 
+// Analytic twin of VisualReprojectionCost (same residual, same failure behind the camera). Stores
+// the four intrinsics instead of a camera copy: a global problem holds millions of these.
+class VisualReprojectionAnalyticCost : public ceres::SizedCostFunction<2, 7, 3> {
+ public:
+  VisualReprojectionAnalyticCost(const PinholeCamera& camera, const Eigen::Vector2d& uv,
+                                 double sqrt_information)
+      : fx_(camera.fx),
+        fy_(camera.fy),
+        cx_(camera.cx),
+        cy_(camera.cy),
+        uv_(uv),
+        sqrt_information_(sqrt_information) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const double fx_, fy_, cx_, cy_;
+  const Eigen::Vector2d uv_;
+  const double sqrt_information_;
+};
+
 class PointToImlsAnalyticCost : public ceres::SizedCostFunction<1, 7, 7> {
  public:
   PointToImlsAnalyticCost(const Eigen::Vector3d& p_x, const Eigen::Vector3d& c_p_y,

@@ -67,6 +67,32 @@ TEST(RotateJacobian, MatchesFiniteDifferences) {
   }
 }
 
+TEST(VisualReprojectionAnalyticCost, MatchesAutodiffAndNumericAndFailsBehindTheCamera) {
+  std::mt19937 rng(5);
+  const PinholeCamera camera = KittiLikeCamera();
+  for (int trial = 0; trial < 10; ++trial) {
+    const Rigid3d world_from_cam = RandomPose(rng, 0.5, 10.0);
+    // A point 4-40 m in front of the camera, observed 0-3 px off its projection.
+    const Eigen::Vector3d x_c(0.3 * trial - 1.5, 0.5, 4.0 + 4.0 * trial);
+    std::array<double, 3> point;
+    Eigen::Map<Eigen::Vector3d>(point.data()) = world_from_cam * x_c;
+    const Eigen::Vector2d uv = camera.Project(x_c) + Eigen::Vector2d(0.3 * trial, -0.2 * trial);
+    PoseBlock pose = ToPoseBlock(world_from_cam);
+    VisualReprojectionAnalyticCost analytic(camera, uv, 1.0 / 1.44);
+    std::unique_ptr<ceres::CostFunction> autodiff(
+        VisualReprojectionCost::Create(camera, uv, 1.0 / 1.44));
+    ExpectSameEvaluation(analytic, *autodiff, {pose.data(), point.data()});
+    EXPECT_LT(LocalJacobianError(analytic, {true, false}, {pose.data(), point.data()}), 1e-5);
+  }
+  const Rigid3d world_from_cam = RandomPose(rng, 0.5, 10.0);
+  std::array<double, 3> behind;
+  Eigen::Map<Eigen::Vector3d>(behind.data()) = world_from_cam * Eigen::Vector3d(0, 0, -5);
+  PoseBlock pose = ToPoseBlock(world_from_cam);
+  const double* params[2] = {pose.data(), behind.data()};
+  double r[2];
+  EXPECT_FALSE(VisualReprojectionAnalyticCost(camera, {600, 180}, 1.0).Evaluate(params, r, nullptr));
+}
+
 TEST(PointToImlsAnalyticCost, MatchesAutodiffAndNumeric) {
   std::mt19937 rng(6);
   for (int trial = 0; trial < 10; ++trial) {

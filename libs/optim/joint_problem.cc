@@ -5,10 +5,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <utility>
 
 #include "core/check.h"
 #include "optim/analytic_costs.h"
 #include "optim/cost_functions.h"
+#include "optim/imls_pair_cost.h"
 
 namespace jvl::optim {
 namespace {
@@ -45,6 +49,13 @@ void CheckResiduals(const JointProblemInput& input) {
                   std::abs(l.c_normal.norm() - 1.0) < 1e-3,
               "IMLS correspondence (" << l.n << ", " << l.c
                                       << ") has non-finite points or a non-unit normal");
+  }
+  for (const ImlsPair& p : input.imls_pairs) {
+    CheckKeyframe(input, p.n, "IMLS pair");
+    CheckKeyframe(input, p.c, "IMLS pair");
+    JVL_CHECK(p.n != p.c, "IMLS pair with n == c == " << p.n << " (must join two keyframes)");
+    JVL_CHECK(p.sum.count() > 0 && p.sum.information().allFinite(),
+              "IMLS pair (" << p.n << ", " << p.c << ") is empty or not finite");
   }
   for (const DirectionConstraint& d : input.directions) {
     CheckKeyframe(input, d.keyframe, "direction constraint");
@@ -92,8 +103,12 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
       continue;
     }
     const double sigma = std::pow(options.octave_scale_factor, obs.octave);
-    jp.visual_blocks.push_back(jp.problem->AddResidualBlock(
-        VisualReprojectionCost::Create(input.camera, obs.uv, 1.0 / sigma), loss, pose, point));
+    ceres::CostFunction* cost =
+        options.analytic_jacobians
+            ? static_cast<ceres::CostFunction*>(
+                  new VisualReprojectionAnalyticCost(input.camera, obs.uv, 1.0 / sigma))
+            : VisualReprojectionCost::Create(input.camera, obs.uv, 1.0 / sigma);
+    jp.visual_blocks.push_back(jp.problem->AddResidualBlock(cost, loss, pose, point));
     used[obs.map_point] = true;
   }
   for (size_t i = 0; i < used.size(); ++i) {
@@ -109,6 +124,22 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
 void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
              ceres::LossFunction* loss, JointProblem& jp) {
   const double sqrt_info = 1.0 / options.imls_sigma_m;
+  if (options.compress_imls && options.imls_huber <= 0) {
+    // One exact block per keyframe pair (imls_pair_cost.h). The sums are formed in a fixed order
+    // (pre-aggregated pairs first, then the correspondences in input order), so they are the
+    // same on every run.
+    std::map<std::pair<int64_t, int64_t>, ImlsPairAccumulator> pairs;
+    for (const ImlsPair& p : input.imls_pairs) pairs[{p.n, p.c}].Merge(p.sum);
+    for (const ImlsCorrespondence& l : input.imls) pairs[{l.n, l.c}].Add(l.p_x, l.c_p_y, l.c_normal);
+    for (const auto& [key, sum] : pairs) {
+      auto cost = std::make_unique<ImlsPairCost>(sum, sqrt_info);
+      if (cost->rank() == 0) continue;  // only for an all-zero sum; nothing to add
+      jp.imls_blocks.push_back(jp.problem->AddResidualBlock(
+          cost.release(), loss, jp.poses.at(key.first).data(), jp.poses.at(key.second).data()));
+      jp.imls_block_counts.push_back(sum.count());
+    }
+    return;
+  }
   for (const ImlsCorrespondence& l : input.imls) {
     double* pose_n = jp.poses.at(l.n).data();
     double* pose_c = jp.poses.at(l.c).data();
@@ -117,6 +148,7 @@ void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
                                          l.p_x, l.c_p_y, l.c_normal, sqrt_info))
                                    : PointToImlsCost::Create(l.p_x, l.c_p_y, l.c_normal, sqrt_info);
     jp.imls_blocks.push_back(jp.problem->AddResidualBlock(cost, loss, pose_n, pose_c));
+    jp.imls_block_counts.push_back(1);
   }
 }
 
@@ -154,6 +186,22 @@ void JointProblemOptions::Check() const {
   JVL_CHECK(
       std::isfinite(visual_huber) && std::isfinite(imls_huber) && std::isfinite(direction_huber),
       "Huber thresholds must be finite");
+}
+
+std::vector<ImlsPair> AggregateImls(const std::vector<ImlsCorrespondence>& correspondences) {
+  std::map<std::pair<int64_t, int64_t>, ImlsPairAccumulator> pairs;
+  for (const ImlsCorrespondence& l : correspondences)
+    pairs[{l.n, l.c}].Add(l.p_x, l.c_p_y, l.c_normal);
+  std::vector<ImlsPair> out;
+  out.reserve(pairs.size());
+  for (const auto& [key, sum] : pairs) out.push_back({key.first, key.second, sum});
+  return out;
+}
+
+int64_t CountImls(const JointProblemInput& input) {
+  int64_t n = static_cast<int64_t>(input.imls.size());
+  for (const ImlsPair& p : input.imls_pairs) n += p.sum.count();
+  return n;
 }
 
 JointWeights ResolveWeights(const JointProblemOptions& options, int64_t num_visual,
@@ -197,9 +245,10 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
     for (auto& d : jp.free_directions) jp.problem->AddParameterBlock(d.data(), 3, sphere);
   }
   // Counts for the weight rule are taken from the inputs (before dropping invalid observations).
+  JVL_CHECK(input.imls_pairs.empty() || (options.compress_imls && options.imls_huber <= 0),
+            "summed IMLS pairs need the compressed e_L form (no Huber kernel on e_L)");
   jp.weights = ResolveWeights(options, static_cast<int64_t>(input.observations.size()),
-                              static_cast<int64_t>(input.imls.size()),
-                              static_cast<int64_t>(input.directions.size()));
+                              CountImls(input), static_cast<int64_t>(input.directions.size()));
   // The problem owns a loss only once a residual uses it; unused ones are freed here.
   std::unique_ptr<ceres::LossFunction> visual_loss(
       MakeLoss(jp.weights.alpha, options.visual_huber));

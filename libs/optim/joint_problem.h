@@ -20,6 +20,7 @@
 
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
+#include "optim/imls_pair_cost.h"
 #include "optim/pose_block.h"
 
 namespace jvl::optim {
@@ -41,6 +42,17 @@ struct ImlsCorrespondence {
   Eigen::Vector3d c_normal = Eigen::Vector3d::UnitZ();  // unit
 };
 
+// All correspondences of one ordered keyframe pair (n, c), summed (imls_pair_cost.h): the form in
+// which a large, fixed set such as the saved set L is kept across solves.
+struct ImlsPair {
+  int64_t n = 0;
+  int64_t c = 0;
+  ImlsPairAccumulator sum;
+};
+
+// Groups correspondences by (n, c): pairs in (n, c) order, each pair's sum in input order.
+std::vector<ImlsPair> AggregateImls(const std::vector<ImlsCorrespondence>& correspondences);
+
 // A vanishing point v of keyframe `keyframe` associated with a world direction prior d_w (Eq. 6).
 struct DirectionConstraint {
   int64_t keyframe = 0;
@@ -58,6 +70,9 @@ struct JointProblemInput {
   std::vector<Eigen::Vector3d> map_points;  // world frame
   std::vector<VisualObservation> observations;
   std::vector<ImlsCorrespondence> imls;
+  // Correspondences already summed per keyframe pair (AggregateImls); merged with `imls` of the
+  // same pair. Needs the compressed form (compress_imls, no Huber kernel on e_L).
+  std::vector<ImlsPair> imls_pairs;
   std::vector<DirectionConstraint> directions;
   std::vector<Eigen::Vector3d> free_directions;  // initial values of the free d_w blocks
 };
@@ -85,12 +100,19 @@ struct JointProblemOptions {
   double direction_min_z = 0.05;  // clamp of DirectionProjectionCost (see cost_functions.h)
   bool optimize_map_points = true;
   bool analytic_jacobians = true;  // analytic e_L / e_D twins (faster, see docs/optimization.md)
+  // Without a Huber kernel on e_L, all correspondences of one keyframe pair (n, c) form one exact
+  // residual block (imls_pair_cost.h): same cost and LM steps, far fewer blocks. false: one block
+  // per correspondence (the form of the equations; used by tests to check the equivalence).
+  bool compress_imls = true;
   void Check() const;
 };
 
 struct JointWeights {
   double alpha = 1.0, beta = 1.0, gamma = 1.0;
 };
+
+// Number of e_L residuals of an input: imls plus the correspondences summed in imls_pairs.
+int64_t CountImls(const JointProblemInput& input);
 
 // Weights for the given residual counts following the rule documented on JointProblemOptions.
 JointWeights ResolveWeights(const JointProblemOptions& options, int64_t num_visual,
@@ -103,6 +125,7 @@ struct JointProblem {
   std::vector<std::array<double, 3>> free_directions;
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks;
+  std::vector<int64_t> imls_block_counts;  // correspondences in each of imls_blocks
   std::set<int64_t> fixed;  // effective constant poses (gauge)
   JointWeights weights;
   int64_t dropped_observations = 0;  // behind the camera at the initial estimate
@@ -119,6 +142,9 @@ struct SolveOptions {
   double parameter_tolerance = 1e-8;
   double max_time_s = 1e9;
   bool log_progress = false;  // Ceres' per-iteration log on stderr
+  // Non-empty: one info log line per LM iteration ("<label> iteration k: cost, time"), the
+  // progress of long solves.
+  std::string progress_label;
   void Check() const;
 };
 

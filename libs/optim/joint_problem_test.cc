@@ -6,12 +6,14 @@
 #include <random>
 
 #include "core/check.h"
+#include "optim/test_util.h"
 #include "optim/toy_road.h"
 
 namespace jvl::optim {
 namespace {
 
 using testing::MakeToyRoad;
+using testing::MaxPoseDifference;
 using testing::ToyRoad;
 constexpr int kKeyframes = testing::kToyKeyframes;
 
@@ -77,16 +79,6 @@ TEST(JointProblem, DirectionPriorsRemoveAYawDriftTheLocalTermsCannotSee) {
   EXPECT_EQ(b.before.imls.count, 30 * (kKeyframes - 1));
   // Gauge: keyframe 0 is fixed.
   EXPECT_EQ(b.poses.at(0).ToArray(), with_dirs.input.poses.at(0).ToArray());
-}
-
-double MaxPoseDifference(const std::map<int64_t, Rigid3d>& a, const std::map<int64_t, Rigid3d>& b) {
-  double worst = 0.0;
-  for (const auto& [id, pose] : a) {
-    const Rigid3d& other = b.at(id);
-    worst = std::max(worst, (pose.translation() - other.translation()).norm());
-    worst = std::max(worst, RotationAngle(pose.rotation().conjugate() * other.rotation()));
-  }
-  return worst;
 }
 
 TEST(JointProblem, ThreadCountDoesNotChangeTheResult) {

@@ -1,7 +1,11 @@
 // Cost breakdown and the Levenberg-Marquardt solve of a built JointProblem.
+#include <ceres/iteration_callback.h>
 #include <ceres/solver.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
 
 #include "core/check.h"
 #include "core/timer.h"
@@ -10,10 +14,12 @@
 namespace jvl::optim {
 namespace {
 
+// `count`: residuals represented by the blocks (a compressed IMLS block stands for all the
+// correspondences of its keyframe pair and its squared norm is their sum of squares).
 ResidualStats Evaluate(ceres::Problem& problem, const std::vector<ceres::ResidualBlockId>& ids,
-                       int threads) {
+                       int64_t count, int threads) {
   ResidualStats stats;
-  stats.count = static_cast<int64_t>(ids.size());
+  stats.count = count;
   if (ids.empty()) return stats;  // an empty list would mean "all residual blocks" to Ceres
   ceres::Problem::EvaluateOptions options;
   options.residual_blocks = ids;
@@ -26,7 +32,7 @@ ResidualStats Evaluate(ceres::Problem& problem, const std::vector<ceres::Residua
   problem.Evaluate(options, nullptr, &residuals, nullptr, nullptr);
   double sum = 0.0;
   for (double r : residuals) sum += r * r;
-  stats.rms = std::sqrt(sum / static_cast<double>(ids.size()));
+  stats.rms = std::sqrt(sum / static_cast<double>(count));
   return stats;
 }
 
@@ -68,6 +74,20 @@ ceres::Solver::Options MakeSolverOptions(JointProblem& jp, const SolveOptions& o
   return so;
 }
 
+class ProgressLog : public ceres::IterationCallback {
+ public:
+  explicit ProgressLog(std::string label) : label_(std::move(label)) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    spdlog::info("{} iteration {}: cost {:.6g}{}, {:.1f} s", label_, s.iteration, s.cost,
+                 s.step_is_successful || s.iteration == 0 ? "" : " (step rejected)",
+                 s.cumulative_time_in_seconds);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  std::string label_;
+};
+
 }  // namespace
 
 void SolveOptions::Check() const {
@@ -80,9 +100,13 @@ void SolveOptions::Check() const {
 
 JointCostBreakdown EvaluateJointCost(JointProblem& jp, int threads) {
   JointCostBreakdown b;
-  b.visual = Evaluate(*jp.problem, jp.visual_blocks, threads);
-  b.imls = Evaluate(*jp.problem, jp.imls_blocks, threads);
-  b.direction = Evaluate(*jp.problem, jp.direction_blocks, threads);
+  int64_t imls_count = 0;
+  for (int64_t c : jp.imls_block_counts) imls_count += c;
+  b.visual = Evaluate(*jp.problem, jp.visual_blocks,
+                      static_cast<int64_t>(jp.visual_blocks.size()), threads);
+  b.imls = Evaluate(*jp.problem, jp.imls_blocks, imls_count, threads);
+  b.direction = Evaluate(*jp.problem, jp.direction_blocks,
+                        static_cast<int64_t>(jp.direction_blocks.size()), threads);
   b.total = b.visual.cost + b.imls.cost + b.direction.cost;
   return b;
 }
@@ -94,7 +118,9 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   JointSolveResult result;
   result.weights = jp.weights;
   result.before = EvaluateJointCost(jp, options.threads);
-  const ceres::Solver::Options so = MakeSolverOptions(jp, options);
+  ceres::Solver::Options so = MakeSolverOptions(jp, options);
+  ProgressLog progress(options.progress_label);
+  if (!options.progress_label.empty()) so.callbacks.push_back(&progress);
   ceres::Solver::Summary summary;
   if (jp.problem->NumResidualBlocks() > 0) {
     ceres::Solve(so, jp.problem.get(), &summary);

@@ -3,6 +3,8 @@
 
 #include <ceres/gradient_checker.h>
 
+#include <algorithm>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -91,6 +93,18 @@ inline double LocalJacobianError(const ceres::CostFunction& cost, const std::vec
         worst = std::max(worst, std::abs(user - numeric) / std::max(1.0, std::abs(user)));
       }
     }
+  }
+  return worst;
+}
+
+// Largest translation (m) or rotation (rad) difference between two sets of poses (ids of a).
+inline double MaxPoseDifference(const std::map<int64_t, Rigid3d>& a,
+                                const std::map<int64_t, Rigid3d>& b) {
+  double worst = 0.0;
+  for (const auto& [id, pose] : a) {
+    const Rigid3d& other = b.at(id);
+    worst = std::max(worst, (pose.translation() - other.translation()).norm());
+    worst = std::max(worst, RotationAngle(pose.rotation().conjugate() * other.rotation()));
   }
   return worst;
 }

@@ -1,13 +1,13 @@
 #include "assemble.h"
 
 #include <map>
+#include <utility>
 
 #include "core/check.h"
 
 namespace jvl::global_opt {
 
-mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual,
-                                            const LocalInput& local,
+mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual, LocalInput&& local,
                                             const io::DirectionsData* directions) {
   JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
             "local and visual artifacts have different keyframes ("
@@ -19,13 +19,14 @@ mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual,
   if (!local.mappoints.empty()) {
     JVL_CHECK(local.mappoints.size() == m,
               "local has " << local.mappoints.size() << " map points, visual " << m);
-    in.map_points = local.mappoints;
+    in.map_points = std::move(local.mappoints);
   } else {
     for (size_t i = 0; i < m; ++i)
       in.map_points.emplace_back(visual.mappoint_position[3 * i],
                                  visual.mappoint_position[3 * i + 1],
                                  visual.mappoint_position[3 * i + 2]);
   }
+  in.observations.reserve(visual.num_observations());
   for (size_t o = 0; o < visual.num_observations(); ++o) {
     const int32_t kp = visual.observation_keypoint[o];
     optim::VisualObservation obs;
@@ -35,8 +36,8 @@ mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual,
     obs.octave = visual.keypoint_octave[kp];
     in.observations.push_back(obs);
   }
-  in.saved_imls = local.imls;
-  in.scans = local.scans;
+  in.saved_imls = std::move(local.imls);
+  in.scans = std::move(local.scans);
   if (in.scans.empty()) in.scans.resize(in.keyframes.size());
   if (directions != nullptr) {
     std::map<int32_t, Eigen::Vector3d> d_w;

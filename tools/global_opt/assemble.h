@@ -9,9 +9,9 @@
 namespace jvl::global_opt {
 
 // Keyframes, map points (refined, else visual's), scans and L come from local; observations
-// (keypoint uv + octave) from visual; direction associations with their cluster's d_w.
-mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual,
-                                            const LocalInput& local,
+// (keypoint uv + octave) from visual; direction associations with their cluster's d_w. The large
+// parts of `local` (scans, L, map points) are moved, not copied.
+mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual, LocalInput&& local,
                                             const io::DirectionsData* directions);
 
 }  // namespace jvl::global_opt

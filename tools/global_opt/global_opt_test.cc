@@ -129,7 +129,7 @@ TEST_F(GlobalOptTest, ArtifactsAssembleToTheSameInput) {
   EXPECT_EQ(local.imls.size(), saved_.size());
   EXPECT_EQ(local.prior.size(), syn_.prior.size());
   const auto dirs = io::ReadDirectionsArtifact(Path("directions.h5"));
-  const auto in = AssembleGlobalInput(io::ReadVisualMap(Path("visual.h5")), local, &dirs);
+  const auto in = AssembleGlobalInput(io::ReadVisualMap(Path("visual.h5")), LocalInput(local), &dirs);
   EXPECT_EQ(in.observations.size(), syn_.input.observations.size());
   EXPECT_EQ(in.map_points.size(), syn_.input.map_points.size());
   EXPECT_EQ(in.directions.size(), syn_.input.directions.size() + 1);

@@ -18,18 +18,25 @@ LocalInput ToLocalInput(const io::LocalMapData& d) {
   LocalInput out;
   out.keyframes = d.keyframes;
   const size_t k = d.keyframes.size();
+  // Sized up front: grown by push_back, the scans of a long sequence took up to twice their size.
+  out.imls.reserve(d.num_correspondences());
   for (size_t i = 0; i < d.num_correspondences(); ++i)
     out.imls.push_back({d.imls_n[i], d.imls_c[i], Row3(d.imls_p_x, i), Row3(d.imls_p_y, i),
                         Row3(d.imls_normal, i).normalized()});
+  out.mappoints.reserve(d.num_mappoints());
   for (size_t i = 0; i < d.num_mappoints(); ++i)
     out.mappoints.push_back(Row3(d.mappoint_position, i));
   if (!d.scan_offset.empty()) {
     out.scans.resize(k);
-    for (size_t i = 0; i < k; ++i)
+    for (size_t i = 0; i < k; ++i) {
+      const auto count = static_cast<size_t>(d.scan_offset[i + 1] - d.scan_offset[i]);
+      out.scans[i].points.reserve(count);
+      out.scans[i].normals.reserve(count);
       for (int64_t j = d.scan_offset[i]; j < d.scan_offset[i + 1]; ++j) {
         out.scans[i].points.push_back(Row3(d.scan_points, static_cast<size_t>(j)));
         out.scans[i].normals.push_back(Row3(d.scan_normals, static_cast<size_t>(j)));
       }
+    }
   }
   out.prior = d.prior;
   return out;

@@ -84,45 +84,58 @@ int main(int argc, char** argv) {
     o.use_saved_imls = !no_saved;
     o.fresh_traversal = !no_fresh;
     o.solve.threads = tool.threads();
+    if (!tool.quiet()) o.solve.progress_label = "global LM";
     o.Check();
     JVL_CHECK(map_voxel == 0 || (map_voxel >= 0.01 && map_voxel <= 100),
               "--map-voxel must be 0 (every point) or in [0.01, 100] m, got " << map_voxel);
     JVL_CHECK(no_direction || !directions_path.empty(),
               "--directions is required unless --no-direction is given");
-    const auto visual = io::ReadVisualMap(visual_path);
-    tool.AddInput(visual_path);
-    JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to optimise)");
-    const auto local = global_opt::ReadLocalInput(local_path);
-    tool.AddInput(local_path);
-    JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
-              local_path << " and " << visual_path << " have different keyframes ("
-                         << local.keyframes.size() << " vs " << visual.keyframes.size()
-                         << "): local_map must have run on this visual artifact");
-    const std::vector<int64_t> parts = visual.CovisibilityPartStarts();
-    if (parts.size() > 1) {
-      spdlog::warn(
-          "{}: the covisibility graph has {} parts (starting at frames {}); keyframes of "
-          "different parts share no map point and are joined only by the LiDAR terms",
-          visual_path, parts.size(), fmt::join(parts, ", "));
-    }
-    io::DirectionsData directions;
-    if (!directions_path.empty()) {
-      directions = io::ReadDirectionsArtifact(directions_path);
-      tool.AddInput(directions_path);
-      if (!no_direction && directions.associations.empty()) {
-        spdlog::warn("{}: no direction prior (no associated VP); optimising without e_D",
-                     directions_path);
+    // The artifacts are released once the problem input is assembled (the largest parts are
+    // moved into it), so they do not add to the peak memory of the solve.
+    mapping::GlobalMapInput input;
+    Trajectory prior;
+    {
+      const auto visual = io::ReadVisualMap(visual_path);
+      tool.AddInput(visual_path);
+      JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to optimise)");
+      auto local = global_opt::ReadLocalInput(local_path);
+      tool.AddInput(local_path);
+      JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
+                local_path << " and " << visual_path << " have different keyframes ("
+                           << local.keyframes.size() << " vs " << visual.keyframes.size()
+                           << "): local_map must have run on this visual artifact");
+      const std::vector<int64_t> parts = visual.CovisibilityPartStarts();
+      if (parts.size() > 1) {
+        spdlog::warn(
+            "{}: the covisibility graph has {} parts (starting at frames {}); keyframes of "
+            "different parts share no map point and are joined only by the LiDAR terms",
+            visual_path, parts.size(), fmt::join(parts, ", "));
       }
+      io::DirectionsData directions;
+      if (!directions_path.empty()) {
+        directions = io::ReadDirectionsArtifact(directions_path);
+        tool.AddInput(directions_path);
+        if (!no_direction && directions.associations.empty()) {
+          spdlog::warn("{}: no direction prior (no associated VP); optimising without e_D",
+                       directions_path);
+        }
+      }
+      prior = local.prior.empty() ? visual.prior : local.prior;
+      if (!prior_path.empty()) {
+        prior = io::ReadTrajectory(prior_path);
+        tool.AddInput(prior_path);
+      }
+      JVL_CHECK(!prior.empty(), "no prior trajectory: pass --prior");
+      o.joint.octave_scale_factor = visual.scale_factor;
+      input = global_opt::AssembleGlobalInput(visual, std::move(local),
+                                              directions_path.empty() ? nullptr : &directions);
     }
-    Trajectory prior = local.prior.empty() ? visual.prior : local.prior;
-    if (!prior_path.empty()) {
-      prior = io::ReadTrajectory(prior_path);
-      tool.AddInput(prior_path);
+    if (o.use_saved_imls && o.joint.compress_imls && o.joint.imls_huber <= 0) {
+      // The set L summed per keyframe pair once (exact, optim/imls_pair_cost.h); the
+      // correspondences themselves are not kept.
+      input.saved_imls_pairs = optim::AggregateImls(input.saved_imls);
+      std::vector<optim::ImlsCorrespondence>().swap(input.saved_imls);
     }
-    JVL_CHECK(!prior.empty(), "no prior trajectory: pass --prior");
-    o.joint.octave_scale_factor = visual.scale_factor;
-    const auto input = global_opt::AssembleGlobalInput(
-        visual, local, directions_path.empty() ? nullptr : &directions);
     const auto result = mapping::OptimizeGlobal(input, o);
     std::map<int64_t, Rigid3d> kf;
     for (size_t i = 0; i < result.keyframes.size(); ++i)
