@@ -9,6 +9,7 @@
 #include <unordered_set>
 
 #include "core/check.h"
+#include "core/memory.h"
 #include "core/threads.h"
 #include "core/timer.h"
 #include "lidar/imls.h"
@@ -213,9 +214,9 @@ void AddToModel(const Trajectory& keyframes, const std::vector<KeyframeScan>& sc
   const Rigid3d& world_from_i = keyframes.world_from_cam[i];
   std::vector<Eigen::Vector3d> wp, wn;
   for (size_t j = 0; j < scans[i].points.size(); ++j) {
-    if (scans[i].normals[j].squaredNorm() < 0.25) continue;
-    wp.push_back(world_from_i * scans[i].points[j]);
-    wn.push_back(world_from_i.rotation() * scans[i].normals[j]);
+    if (scans[i].normals[j].squaredNorm() < 0.25f) continue;
+    wp.push_back(world_from_i * scans[i].points[j].cast<double>());
+    wn.push_back(world_from_i.rotation() * scans[i].normals[j].cast<double>());
   }
   model->AddScan(static_cast<int64_t>(i), wp, wn);
 }
@@ -232,25 +233,29 @@ std::vector<optim::ImlsCorrespondence> TraverseKeyframe(const Trajectory& keyfra
   // IMLS-SLAM sampling on the stored normals (planarity taken as 1: the stored scan keeps
   // only points that had a normal).
   lidar::ScanSurface surface;
-  surface.points = scan.points;
-  surface.normals = scan.normals;
+  surface.points.reserve(scan.points.size());
+  surface.normals.reserve(scan.points.size());
+  for (size_t j = 0; j < scan.points.size(); ++j) {
+    surface.points.push_back(scan.points[j].cast<double>());
+    surface.normals.push_back(scan.normals[j].cast<double>());
+  }
   surface.planarity.assign(scan.points.size(), 1.0);
   surface.valid.resize(scan.points.size());
   for (size_t j = 0; j < scan.points.size(); ++j)
-    surface.valid[j] = scan.normals[j].squaredNorm() >= 0.25 ? 1 : 0;
+    surface.valid[j] = surface.normals[j].squaredNorm() >= 0.25 ? 1 : 0;
   const size_t per_list = static_cast<size_t>(options.samples_per_list);
   const auto lists = lidar::SamplingLists(surface, 20 * per_list);
   const Rigid3d& world_from_n = keyframes.world_from_cam[n];
   const auto samples =
       lidar::SelectSamples(lists, scan.points.size(), options.samples_per_list, [&](int j) {
-        return model.HasNeighbor(world_from_n * scan.points[j], options.search_radius);
+        return model.HasNeighbor(world_from_n * surface.points[j], options.search_radius);
       });
   std::vector<uint8_t> ok(samples.size(), 0);
   std::vector<optim::ImlsCorrespondence> found(samples.size());
   ParallelFor(static_cast<int64_t>(samples.size()), threads, [&](int64_t s) {
     const int j = samples[s];
     lidar::ImlsProjection proj;
-    if (!model.Project(world_from_n * scan.points[j], options.kernel_h, options.search_radius,
+    if (!model.Project(world_from_n * surface.points[j], options.kernel_h, options.search_radius,
                        &proj))
       return;
     if (std::abs(proj.distance) > options.max_distance || proj.nearest_scan < 0) return;
@@ -259,7 +264,7 @@ std::vector<optim::ImlsCorrespondence> TraverseKeyframe(const Trajectory& keyfra
     optim::ImlsCorrespondence& l = found[s];
     l.n = static_cast<int64_t>(n);
     l.c = static_cast<int64_t>(c);
-    l.p_x = scan.points[j];
+    l.p_x = surface.points[j];
     l.c_p_y = cam_from_world * proj.projection;  // ^c p_y = T_cw p_y (step 4)
     l.c_normal = (cam_from_world.rotation() * proj.normal).normalized();
     ok[s] = 1;
@@ -348,8 +353,7 @@ void PrepareDirections(const Trajectory& keyframes, const PinholeCamera& camera,
 
 }  // namespace
 
-GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
-                                   const GlobalMappingOptions& options) {
+GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOptions& options) {
   const Timer total;
   options.Check();
   input.Check();
@@ -358,7 +362,7 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   problem.camera = input.camera;
   problem.fixed = {0};  // gauge: the first keyframe
   problem.map_points = input.map_points;
-  problem.observations = input.observations;
+  problem.shared_observations = &input.observations;
   const DirectionSelection dirs = SelectDirections(input.keyframes, input.directions);
   result.directions_not_keyframe = dirs.not_keyframe;
   result.directions_at_infinity = dirs.at_infinity;
@@ -374,8 +378,8 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
   optim::JointCostBreakdown first_before;
   // The saved set L does not change between rounds: summed per keyframe pair once (exact, see
   // optim/imls_pair_cost.h) instead of copying millions of correspondences into every round.
-  const bool summed_saved =
-      options.use_saved_imls && options.joint.compress_imls && options.joint.imls_huber <= 0;
+  const bool aggregate = options.joint.compress_imls && options.joint.imls_huber <= 0;
+  const bool summed_saved = options.use_saved_imls && aggregate;
   JVL_CHECK(input.saved_imls_pairs.empty() || !options.use_saved_imls || summed_saved,
             "the saved IMLS set is given summed per keyframe pair, which needs the compressed "
             "e_L form (no Huber kernel on e_L)");
@@ -431,9 +435,16 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
       const Timer t;
       const auto l =
           TraverseImls(result.keyframes, input.scans, options.traversal, options.solve.threads);
-      problem.imls.insert(problem.imls.end(), l.begin(), l.end());
+      if (aggregate) {  // kept summed as well (the raw list is not needed for the solve)
+        const auto fresh_pairs = optim::AggregateImls(l);
+        problem.imls_pairs.insert(problem.imls_pairs.end(), fresh_pairs.begin(),
+                                  fresh_pairs.end());
+      } else {
+        problem.imls.insert(problem.imls.end(), l.begin(), l.end());
+      }
       result.fresh_imls = static_cast<int64_t>(l.size());
       result.traversal_time_s += t.ElapsedSeconds();
+      if (round == rounds - 1) std::vector<KeyframeScan>().swap(input.scans);  // not needed now
     }
     // Warm-start round without e_D: the report's "before" is still the full energy at the input
     // poses. Its visual and IMLS parts are this round's; e_D's part is evaluated on its own with
@@ -449,7 +460,7 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
       only.fixed = problem.fixed;
       only.directions = dirs.constraints;
       const optim::JointWeights w = optim::ResolveWeights(
-          joint, static_cast<int64_t>(problem.observations.size()),
+          joint, static_cast<int64_t>(problem.Observations().size()),
           optim::CountImls(problem), static_cast<int64_t>(dirs.constraints.size()));
       optim::JointProblemOptions o = joint;
       o.alpha = w.alpha;
@@ -462,6 +473,7 @@ GlobalMappingResult OptimizeGlobal(const GlobalMapInput& input,
     if (!solve.progress_label.empty())
       solve.progress_label += " round " + std::to_string(round + 1) + "/" + std::to_string(rounds);
     result.solve = optim::OptimizeJoint(problem, joint, solve);
+    ReleaseFreeHeapMemory();  // the round's Ceres problem is gone (core/memory.h)
     ++result.rounds;
     result.total_iterations += result.solve.iterations;
     if (round == 0) {
@@ -528,7 +540,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
           {"weights",
            {{"alpha", s.weights.alpha}, {"beta", s.weights.beta}, {"gamma", s.weights.gamma}}},
           {"weights_from_rule", {{"beta", o.joint.beta <= 0}, {"gamma", o.joint.gamma <= 0}}},
-          {"imls", {{"saved", r.saved_imls}, {"fresh", r.fresh_imls}}},
+          {"imls", {{"saved", r.saved_imls}, {"fresh", r.fresh_imls}, {"blocks", s.imls_blocks}}},
           {"directions",
            {{"used", r.directions_used},
             {"not_keyframe", r.directions_not_keyframe},
@@ -565,8 +577,8 @@ std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,
   std::unordered_set<uint64_t, lidar::CellHash> occupied;
   const double inv = voxel_size > 0 ? 1.0 / voxel_size : 0.0;
   for (size_t k = 0; k < scans.size(); ++k) {
-    for (const Eigen::Vector3d& p : scans[k].points) {
-      const Eigen::Vector3d w = keyframes.world_from_cam[k] * p;
+    for (const Eigen::Vector3f& p : scans[k].points) {
+      const Eigen::Vector3d w = keyframes.world_from_cam[k] * p.cast<double>();
       if (voxel_size > 0) {
         const Eigen::Vector3i c = lidar::CellOf(w, inv);
         if (!occupied.insert(lidar::PackCell(c.x(), c.y(), c.z())).second) continue;

@@ -80,8 +80,8 @@ inline void AddScanPoint(const std::vector<Rigid3d>& prior_kf, double step,
   const Rigid3d frame = PriorAt(prior_kf, step, road.z());
   const Eigen::Vector3d n_w = frame.rotation() * road_normal;
   const Eigen::Vector3d p_w = Perceived(prior_kf, step, road) + noise * n_w;
-  scan->points.push_back(cam_from_world * p_w);
-  scan->normals.push_back(cam_from_world.rotation() * n_w);
+  scan->points.push_back((cam_from_world * p_w).cast<float>());
+  scan->normals.push_back((cam_from_world.rotation() * n_w).cast<float>());
 }
 
 inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {

@@ -31,7 +31,7 @@ void CheckKeyframe(const JointProblemInput& input, int64_t id, const char* what)
 
 // All validation happens before anything is added to the problem (no half-built state).
 void CheckResiduals(const JointProblemInput& input) {
-  for (const VisualObservation& obs : input.observations) {
+  for (const VisualObservation& obs : input.Observations()) {
     CheckKeyframe(input, obs.keyframe, "visual observation");
     JVL_CHECK(obs.map_point >= 0 && static_cast<size_t>(obs.map_point) < input.map_points.size(),
               "observation in keyframe " << obs.keyframe << " refers to map point " << obs.map_point
@@ -91,7 +91,7 @@ void CheckInput(const JointProblemInput& input) {
 void AddVisual(const JointProblemInput& input, const JointProblemOptions& options,
                ceres::LossFunction* loss, JointProblem& jp) {
   std::vector<bool> used(input.map_points.size(), false);
-  for (const VisualObservation& obs : input.observations) {
+  for (const VisualObservation& obs : input.Observations()) {
     double* pose = jp.poses.at(obs.keyframe).data();
     double* point = jp.map_points[obs.map_point].data();
     // Drop what is behind the camera now: the functor could not be evaluated (ORB-SLAM removes
@@ -247,7 +247,7 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
   // Counts for the weight rule are taken from the inputs (before dropping invalid observations).
   JVL_CHECK(input.imls_pairs.empty() || (options.compress_imls && options.imls_huber <= 0),
             "summed IMLS pairs need the compressed e_L form (no Huber kernel on e_L)");
-  jp.weights = ResolveWeights(options, static_cast<int64_t>(input.observations.size()),
+  jp.weights = ResolveWeights(options, static_cast<int64_t>(input.Observations().size()),
                               CountImls(input), static_cast<int64_t>(input.directions.size()));
   // The problem owns a loss only once a residual uses it; unused ones are freed here.
   std::unique_ptr<ceres::LossFunction> visual_loss(

@@ -69,6 +69,12 @@ struct JointProblemInput {
   std::set<int64_t> fixed;                  // keyframes held constant; empty: the first id is fixed
   std::vector<Eigen::Vector3d> map_points;  // world frame
   std::vector<VisualObservation> observations;
+  // If set, used instead of `observations` (a caller that keeps millions of observations across
+  // several solves passes them without a copy; they must outlive the build).
+  const std::vector<VisualObservation>* shared_observations = nullptr;
+  const std::vector<VisualObservation>& Observations() const {
+    return shared_observations != nullptr ? *shared_observations : observations;
+  }
   std::vector<ImlsCorrespondence> imls;
   // Correspondences already summed per keyframe pair (AggregateImls); merged with `imls` of the
   // same pair. Needs the compressed form (compress_imls, no Huber kernel on e_L).
@@ -165,6 +171,7 @@ struct JointSolveResult {
   JointCostBreakdown before, after;
   JointWeights weights;
   int iterations = 0;
+  int64_t imls_blocks = 0;  // residual blocks holding the e_L terms (one per pair when summed)
   double time_s = 0.0;
   bool usable = false;      // Ceres returned CONVERGENCE or NO_CONVERGENCE (not FAILURE)
   std::string termination;  // Ceres' summary line

@@ -117,6 +117,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   const Timer timer;
   JointSolveResult result;
   result.weights = jp.weights;
+  result.imls_blocks = static_cast<int64_t>(jp.imls_blocks.size());
   result.before = EvaluateJointCost(jp, options.threads);
   ceres::Solver::Options so = MakeSolverOptions(jp, options);
   ProgressLog progress(options.progress_label);

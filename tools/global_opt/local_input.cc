@@ -12,13 +12,32 @@ Eigen::Vector3d Row3(const std::vector<T>& a, size_t i) {
   return Eigen::Vector3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
 }
 
+// The stored scans (single precision, as in the file), one per keyframe; empty if absent.
+std::vector<mapping::KeyframeScan> ScansOf(const io::LocalMapData& d) {
+  std::vector<mapping::KeyframeScan> scans;
+  if (d.scan_offset.empty()) return scans;
+  const size_t k = d.keyframes.size();
+  scans.resize(k);
+  for (size_t i = 0; i < k; ++i) {
+    // Sized up front: grown by push_back, the scans of a long sequence took up to twice their size.
+    const auto count = static_cast<size_t>(d.scan_offset[i + 1] - d.scan_offset[i]);
+    scans[i].points.reserve(count);
+    scans[i].normals.reserve(count);
+    for (int64_t j = d.scan_offset[i]; j < d.scan_offset[i + 1]; ++j) {
+      const size_t r = 3 * static_cast<size_t>(j);
+      scans[i].points.emplace_back(d.scan_points[r], d.scan_points[r + 1], d.scan_points[r + 2]);
+      scans[i].normals.emplace_back(d.scan_normals[r], d.scan_normals[r + 1],
+                                    d.scan_normals[r + 2]);
+    }
+  }
+  return scans;
+}
+
 }  // namespace
 
 LocalInput ToLocalInput(const io::LocalMapData& d) {
   LocalInput out;
   out.keyframes = d.keyframes;
-  const size_t k = d.keyframes.size();
-  // Sized up front: grown by push_back, the scans of a long sequence took up to twice their size.
   out.imls.reserve(d.num_correspondences());
   for (size_t i = 0; i < d.num_correspondences(); ++i)
     out.imls.push_back({d.imls_n[i], d.imls_c[i], Row3(d.imls_p_x, i), Row3(d.imls_p_y, i),
@@ -26,22 +45,15 @@ LocalInput ToLocalInput(const io::LocalMapData& d) {
   out.mappoints.reserve(d.num_mappoints());
   for (size_t i = 0; i < d.num_mappoints(); ++i)
     out.mappoints.push_back(Row3(d.mappoint_position, i));
-  if (!d.scan_offset.empty()) {
-    out.scans.resize(k);
-    for (size_t i = 0; i < k; ++i) {
-      const auto count = static_cast<size_t>(d.scan_offset[i + 1] - d.scan_offset[i]);
-      out.scans[i].points.reserve(count);
-      out.scans[i].normals.reserve(count);
-      for (int64_t j = d.scan_offset[i]; j < d.scan_offset[i + 1]; ++j) {
-        out.scans[i].points.push_back(Row3(d.scan_points, static_cast<size_t>(j)));
-        out.scans[i].normals.push_back(Row3(d.scan_normals, static_cast<size_t>(j)));
-      }
-    }
-  }
+  out.scans = ScansOf(d);
   out.prior = d.prior;
   return out;
 }
 
 LocalInput ReadLocalInput(const std::string& path) { return ToLocalInput(io::ReadLocalMap(path)); }
+
+std::vector<mapping::KeyframeScan> ReadLocalScans(const std::string& path) {
+  return ScansOf(io::ReadLocalMap(path));
+}
 
 }  // namespace jvl::global_opt

@@ -23,5 +23,7 @@ struct LocalInput {
 
 LocalInput ToLocalInput(const io::LocalMapData& data);
 LocalInput ReadLocalInput(const std::string& path);
+// Only the stored scans (for the map export after the optimisation has released its copy).
+std::vector<mapping::KeyframeScan> ReadLocalScans(const std::string& path);
 
 }  // namespace jvl::global_opt

@@ -7,6 +7,7 @@
 #include "app/tool.h"
 #include "assemble.h"
 #include "core/check.h"
+#include "core/memory.h"
 #include "io/global_io.h"
 #include "io/ply_io.h"
 #include "io/trajectory_io.h"
@@ -71,7 +72,8 @@ int main(int argc, char** argv) {
                  "Huber threshold of e_D in sigmas (<= 0: none)")
       ->capture_default_str();
   cli.add_flag("!--fixed-map-points", o.joint.optimize_map_points,
-               "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only)");
+               "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only; "
+               "several times faster on long sequences, see docs/global_opt.md)");
   cli.add_option("--map", map_path, "Accumulated map PLY (stored scans, optimised poses)");
   cli.add_option("--map-voxel", map_voxel, "Voxel size (m) of the map")->capture_default_str();
   cli.add_flag("--map-ascii", map_ascii, "Write the PLY as ASCII instead of binary");
@@ -136,7 +138,8 @@ int main(int argc, char** argv) {
       input.saved_imls_pairs = optim::AggregateImls(input.saved_imls);
       std::vector<optim::ImlsCorrespondence>().swap(input.saved_imls);
     }
-    const auto result = mapping::OptimizeGlobal(input, o);
+    ReleaseFreeHeapMemory();  // what reading the artifacts allocated and freed (core/memory.h)
+    const auto result = mapping::OptimizeGlobal(std::move(input), o);
     std::map<int64_t, Rigid3d> kf;
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       kf[result.keyframes.frames[i]] = result.keyframes.world_from_cam[i];
@@ -147,18 +150,22 @@ int main(int argc, char** argv) {
     out.stats = mapping::GlobalStatsJson(result, o);
     io::WriteGlobalArtifact(output, out, tool.MakeProvenance());
     if (!kitti.empty()) io::WriteTrajectoryKitti(kitti, out.trajectory);
-    if (!map_path.empty())
-      io::WritePly(map_path, mapping::AccumulateMap(result.keyframes, input.scans, map_voxel),
+    if (!map_path.empty()) {
+      // OptimizeGlobal released its scans before the last solve; they are read again.
+      auto scans = global_opt::ReadLocalScans(local_path);
+      if (scans.empty()) scans.resize(result.keyframes.size());  // local.h5 without scans
+      io::WritePly(map_path, mapping::AccumulateMap(result.keyframes, scans, map_voxel),
                    !map_ascii);
+    }
     const auto& s = result.solve;
     spdlog::info(
-        "{} keyframes, {} frames: {} visual, {} IMLS ({} saved + {} fresh), {} direction "
+        "{} keyframes, {} frames: {} visual, {} IMLS ({} saved + {} fresh, {} keyframe-pair blocks), {} direction "
         "residuals ({} skipped: not keyframes, {} at infinity, {} refit outliers; sigma {:.2f} "
         "px); weights alpha {:.3g} beta {:.3g} "
         "gamma {:.3g}; cost {:.6g} -> {:.6g}; {} rounds, {} iterations ({:.2f} s IMLS "
         "traversal, {:.2f} s total)",
         result.keyframes.size(), out.trajectory.size(), s.before.visual.count, s.before.imls.count,
-        result.saved_imls, result.fresh_imls, result.directions_used,
+        result.saved_imls, result.fresh_imls, s.imls_blocks, result.directions_used,
         result.directions_not_keyframe, result.directions_at_infinity,
         result.directions_outliers, result.direction_sigma_px, s.weights.alpha,
         s.weights.beta, s.weights.gamma, s.before.total, s.after.total, result.rounds,
