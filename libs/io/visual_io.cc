@@ -1,5 +1,8 @@
 #include "io/visual_io.h"
 
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 
 #include "core/check.h"
@@ -137,6 +140,15 @@ VisualMapData ReadVisualMap(const std::string& path) {
   d.summary = r.ReadJson("summary");
   d.Check(path);
   return d;
+}
+
+void WarnIfCovisibilitySplit(const VisualMapData& data, const std::string& path) {
+  const std::vector<int64_t> parts = data.CovisibilityPartStarts();
+  if (parts.size() <= 1) return;
+  spdlog::warn(
+      "{}: the covisibility graph has {} parts (starting at frames {}); keyframes of different "
+      "parts share no map point and are joined only by the LiDAR terms",
+      path, parts.size(), fmt::join(parts, ", "));
 }
 
 }  // namespace jvl::io

@@ -58,6 +58,10 @@ struct VisualMapData {
   std::vector<int64_t> CovisibilityPartStarts() const;
 };
 
+// Logs a warning naming `path` when the covisibility graph has more than one part (keyframes of
+// different parts share no map point; only the LiDAR terms join them).
+void WarnIfCovisibilitySplit(const VisualMapData& data, const std::string& path);
+
 void WriteVisualMap(const std::string& path, const VisualMapData& data,
                     const Provenance& provenance);
 VisualMapData ReadVisualMap(const std::string& path);

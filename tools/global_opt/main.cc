@@ -1,7 +1,6 @@
 // global_opt: global joint optimisation of all keyframes with direction priors (Sec. 4.3,
 // Eq. 5-8). Reads only artifacts (local.h5, visual.h5, directions.h5, optional prior), so a rerun
 // with other weights needs neither the dataset nor a new feature association.
-#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "app/tool.h"
@@ -106,13 +105,7 @@ int main(int argc, char** argv) {
                 local_path << " and " << visual_path << " have different keyframes ("
                            << local.keyframes.size() << " vs " << visual.keyframes.size()
                            << "): local_map must have run on this visual artifact");
-      const std::vector<int64_t> parts = visual.CovisibilityPartStarts();
-      if (parts.size() > 1) {
-        spdlog::warn(
-            "{}: the covisibility graph has {} parts (starting at frames {}); keyframes of "
-            "different parts share no map point and are joined only by the LiDAR terms",
-            visual_path, parts.size(), fmt::join(parts, ", "));
-      }
+      io::WarnIfCovisibilitySplit(visual, visual_path);
       io::DirectionsData directions;
       if (!directions_path.empty()) {
         directions = io::ReadDirectionsArtifact(directions_path);

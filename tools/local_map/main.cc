@@ -1,6 +1,5 @@
 // local_map: joint visual + point-to-IMLS optimisation per keyframe (paper Sec. 4.2,
 // supplement 1.2) over the visual map of visual_assoc and the dataset's scans.
-#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -38,13 +37,7 @@ int main(int argc, char** argv) {
     const io::VisualMapData visual = io::ReadVisualMap(visual_path);
     tool.AddInput(visual_path);
     JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to refine)");
-    const std::vector<int64_t> parts = visual.CovisibilityPartStarts();
-    if (parts.size() > 1) {
-      spdlog::warn(
-          "{}: the covisibility graph has {} parts (starting at frames {}); keyframes of "
-          "different parts share no map point and are joined only by the LiDAR terms",
-          visual_path, parts.size(), fmt::join(parts, ", "));
-    }
+    io::WarnIfCovisibilitySplit(visual, visual_path);
     Trajectory prior = visual.prior;
     if (!prior_path.empty()) {
       prior = io::ReadTrajectory(prior_path);
