@@ -378,7 +378,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   optim::JointCostBreakdown first_before;
   // The saved set L does not change between rounds: summed per keyframe pair once (exact, see
   // optim/imls_pair_cost.h) instead of copying millions of correspondences into every round.
-  const bool aggregate = options.joint.compress_imls && options.joint.imls_huber <= 0;
+  const bool aggregate = options.joint.SumsImlsPerPair();
   const bool summed_saved = options.use_saved_imls && aggregate;
   JVL_CHECK(input.saved_imls_pairs.empty() || !options.use_saved_imls || summed_saved,
             "the saved IMLS set is given summed per keyframe pair, which needs the compressed "

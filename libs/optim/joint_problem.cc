@@ -25,6 +25,17 @@ ceres::LossFunction* MakeLoss(double weight, double huber) {
   return new ceres::ScaledLoss(robust, weight, ceres::TAKE_OWNERSHIP);
 }
 
+// Sums per ordered keyframe pair: the summed pairs first, then the correspondences in input order
+// (a fixed order, so the sums are the same on every run).
+std::map<std::pair<int64_t, int64_t>, ImlsPairAccumulator> SumByPair(
+    const std::vector<ImlsPair>& summed, const std::vector<ImlsCorrespondence>& correspondences) {
+  std::map<std::pair<int64_t, int64_t>, ImlsPairAccumulator> pairs;
+  for (const ImlsPair& p : summed) pairs[{p.n, p.c}].Merge(p.sum);
+  for (const ImlsCorrespondence& l : correspondences)
+    pairs[{l.n, l.c}].Add(l.p_x, l.c_p_y, l.c_normal);
+  return pairs;
+}
+
 void CheckKeyframe(const JointProblemInput& input, int64_t id, const char* what) {
   JVL_CHECK(input.poses.count(id), what << " refers to keyframe " << id << " which has no pose");
 }
@@ -124,14 +135,9 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
 void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
              ceres::LossFunction* loss, JointProblem& jp) {
   const double sqrt_info = 1.0 / options.imls_sigma_m;
-  if (options.compress_imls && options.imls_huber <= 0) {
-    // One exact block per keyframe pair (imls_pair_cost.h). The sums are formed in a fixed order
-    // (pre-aggregated pairs first, then the correspondences in input order), so they are the
-    // same on every run.
-    std::map<std::pair<int64_t, int64_t>, ImlsPairAccumulator> pairs;
-    for (const ImlsPair& p : input.imls_pairs) pairs[{p.n, p.c}].Merge(p.sum);
-    for (const ImlsCorrespondence& l : input.imls) pairs[{l.n, l.c}].Add(l.p_x, l.c_p_y, l.c_normal);
-    for (const auto& [key, sum] : pairs) {
+  if (options.SumsImlsPerPair()) {
+    // One exact block per keyframe pair (imls_pair_cost.h).
+    for (const auto& [key, sum] : SumByPair(input.imls_pairs, input.imls)) {
       auto cost = std::make_unique<ImlsPairCost>(sum, sqrt_info);
       if (cost->rank() == 0) continue;  // only for an all-zero sum; nothing to add
       jp.imls_blocks.push_back(jp.problem->AddResidualBlock(
@@ -189,9 +195,7 @@ void JointProblemOptions::Check() const {
 }
 
 std::vector<ImlsPair> AggregateImls(const std::vector<ImlsCorrespondence>& correspondences) {
-  std::map<std::pair<int64_t, int64_t>, ImlsPairAccumulator> pairs;
-  for (const ImlsCorrespondence& l : correspondences)
-    pairs[{l.n, l.c}].Add(l.p_x, l.c_p_y, l.c_normal);
+  const auto pairs = SumByPair({}, correspondences);
   std::vector<ImlsPair> out;
   out.reserve(pairs.size());
   for (const auto& [key, sum] : pairs) out.push_back({key.first, key.second, sum});
@@ -245,7 +249,7 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
     for (auto& d : jp.free_directions) jp.problem->AddParameterBlock(d.data(), 3, sphere);
   }
   // Counts for the weight rule are taken from the inputs (before dropping invalid observations).
-  JVL_CHECK(input.imls_pairs.empty() || (options.compress_imls && options.imls_huber <= 0),
+  JVL_CHECK(input.imls_pairs.empty() || options.SumsImlsPerPair(),
             "summed IMLS pairs need the compressed e_L form (no Huber kernel on e_L)");
   jp.weights = ResolveWeights(options, static_cast<int64_t>(input.Observations().size()),
                               CountImls(input), static_cast<int64_t>(input.directions.size()));

@@ -110,6 +110,8 @@ struct JointProblemOptions {
   // residual block (imls_pair_cost.h): same cost and LM steps, far fewer blocks. false: one block
   // per correspondence (the form of the equations; used by tests to check the equivalence).
   bool compress_imls = true;
+  // Whether e_L is built as one block per keyframe pair: compress_imls and no Huber kernel on e_L.
+  bool SumsImlsPerPair() const { return compress_imls && imls_huber <= 0; }
   void Check() const;
 };
 

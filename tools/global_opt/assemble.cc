@@ -38,7 +38,6 @@ mapping::GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual, Loc
   }
   in.saved_imls = std::move(local.imls);
   in.scans = std::move(local.scans);
-  if (in.scans.empty()) in.scans.resize(in.keyframes.size());
   if (directions != nullptr) {
     std::map<int32_t, Eigen::Vector3d> d_w;
     for (const auto& c : directions->clusters) d_w[c.id] = c.direction;

@@ -12,12 +12,12 @@ Eigen::Vector3d Row3(const std::vector<T>& a, size_t i) {
   return Eigen::Vector3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
 }
 
-// The stored scans (single precision, as in the file), one per keyframe; empty if absent.
+// The stored scans (single precision, as in the file), one per keyframe; all empty if the file
+// has none.
 std::vector<mapping::KeyframeScan> ScansOf(const io::LocalMapData& d) {
-  std::vector<mapping::KeyframeScan> scans;
-  if (d.scan_offset.empty()) return scans;
   const size_t k = d.keyframes.size();
-  scans.resize(k);
+  std::vector<mapping::KeyframeScan> scans(k);
+  if (d.scan_offset.empty()) return scans;
   for (size_t i = 0; i < k; ++i) {
     // Sized up front: grown by push_back, the scans of a long sequence took up to twice their size.
     const auto count = static_cast<size_t>(d.scan_offset[i + 1] - d.scan_offset[i]);

@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
       input = global_opt::AssembleGlobalInput(visual, std::move(local),
                                               directions_path.empty() ? nullptr : &directions);
     }
-    if (o.use_saved_imls && o.joint.compress_imls && o.joint.imls_huber <= 0) {
+    if (o.use_saved_imls && o.joint.SumsImlsPerPair()) {
       // The set L summed per keyframe pair once (exact, optim/imls_pair_cost.h); the
       // correspondences themselves are not kept.
       input.saved_imls_pairs = optim::AggregateImls(input.saved_imls);
@@ -145,9 +145,9 @@ int main(int argc, char** argv) {
     if (!kitti.empty()) io::WriteTrajectoryKitti(kitti, out.trajectory);
     if (!map_path.empty()) {
       // OptimizeGlobal released its scans before the last solve; they are read again.
-      auto scans = global_opt::ReadLocalScans(local_path);
-      if (scans.empty()) scans.resize(result.keyframes.size());  // local.h5 without scans
-      io::WritePly(map_path, mapping::AccumulateMap(result.keyframes, scans, map_voxel),
+      io::WritePly(map_path,
+                   mapping::AccumulateMap(result.keyframes,
+                                          global_opt::ReadLocalScans(local_path), map_voxel),
                    !map_ascii);
     }
     const auto& s = result.solve;
