@@ -25,6 +25,9 @@ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DJVL_BUILD_TESTS=ON \
 cmake --build "$build_dir" -j"$jobs"
 ctest --test-dir "$build_dir" --output-on-failure -j"$jobs"
 echo "test.sh: release build and tests took $(( $(date +%s) - start )) s"
+# A build without the tests (-DJVL_BUILD_TESTS=OFF) must configure as well (no build: same code).
+cmake -S . -B "$build_dir-notests" -DCMAKE_BUILD_TYPE=Release -DJVL_BUILD_TESTS=OFF >/dev/null
+echo "test.sh: configuration with JVL_BUILD_TESTS=OFF passed"
 
 if [ "${JVL_SANITIZE_CI:-ON}" = ON ]; then
   start=$(date +%s)
