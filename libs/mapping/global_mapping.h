@@ -68,7 +68,9 @@ struct ImlsTraversalOptions {
 };
 
 struct GlobalMappingOptions {
-  optim::JointProblemOptions joint;  // alpha/beta/gamma (<= 0: ResolveWeights rule), sigmas.
+  // alpha/beta/gamma (<= 0: ResolveWeights rule), sigmas; the visual gate and the holding of
+  // weak map points (off by default, docs/global_opt.md "Long sequences with free map points").
+  optim::JointProblemOptions joint;
   optim::SolveOptions solve;         // LM iterations, threads.
   ImlsTraversalOptions traversal;
   bool use_directions = true;   // false: the --no-direction ablation.

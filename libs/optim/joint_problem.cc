@@ -1,10 +1,12 @@
 #include "optim/joint_problem.h"
 
+#include <Eigen/Eigenvalues>
 #include <ceres/loss_function.h>
 #include <ceres/sphere_manifold.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <utility>
@@ -101,10 +103,18 @@ void CheckInput(const JointProblemInput& input) {
 
 void AddVisual(const JointProblemInput& input, const JointProblemOptions& options,
                ceres::LossFunction* loss, JointProblem& jp) {
-  std::vector<bool> used(input.map_points.size(), false);
-  for (const VisualObservation& obs : input.Observations()) {
-    double* pose = jp.poses.at(obs.keyframe).data();
-    double* point = jp.map_points[obs.map_point].data();
+  const auto& observations = input.Observations();
+  // First pass: which observations enter (in front of the camera, within the gate).
+  std::vector<char> keep(observations.size(), 0);
+  std::vector<int32_t> kept_per_point(input.map_points.size(), 0);
+  // For max_point_sigma_ratio: each point's information sum J^T J and nearest camera distance.
+  const bool check_weak = options.optimize_map_points && options.max_point_sigma_ratio > 0;
+  std::vector<Eigen::Matrix3d> information(check_weak ? input.map_points.size() : 0,
+                                           Eigen::Matrix3d::Zero());
+  std::vector<double> nearest(check_weak ? input.map_points.size() : 0,
+                              std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k < observations.size(); ++k) {
+    const VisualObservation& obs = observations[k];
     // Drop what is behind the camera now: the functor could not be evaluated (ORB-SLAM removes
     // such observations before BA as well).
     const Eigen::Vector3d x_c =
@@ -113,6 +123,47 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
       ++jp.dropped_observations;
       continue;
     }
+    if (options.visual_gate_chi2 > 0) {
+      const double sigma = std::pow(options.octave_scale_factor, obs.octave);
+      const Eigen::Vector2d error = (input.camera.Project(x_c) - obs.uv) / sigma;
+      if (!(error.squaredNorm() <= options.visual_gate_chi2)) {
+        ++jp.gated_observations;
+        continue;
+      }
+    }
+    keep[k] = 1;
+    ++kept_per_point[obs.map_point];
+    if (check_weak) {
+      const double s = 1.0 / std::pow(options.octave_scale_factor, obs.octave);
+      const double inv_z = 1.0 / x_c.z();
+      Eigen::Matrix<double, 2, 3> j;
+      j << input.camera.fx * inv_z, 0, -input.camera.fx * x_c.x() * inv_z * inv_z,  //
+          0, input.camera.fy * inv_z, -input.camera.fy * x_c.y() * inv_z * inv_z;
+      j *= s;
+      const Eigen::Matrix<double, 2, 3> j_w =
+          j * input.poses.at(obs.keyframe).RotationMatrix().transpose();
+      information[obs.map_point] += j_w.transpose() * j_w;
+      nearest[obs.map_point] = std::min(nearest[obs.map_point], x_c.norm());
+    }
+  }
+  // A free point with a single observation has no depth information: leave it out.
+  const bool gate_points = options.visual_gate_chi2 > 0 && options.optimize_map_points;
+  if (gate_points) {
+    std::vector<char> counted(input.map_points.size(), 0);
+    for (size_t k = 0; k < observations.size(); ++k) {
+      const int64_t point = observations[k].map_point;
+      if (!keep[k] || kept_per_point[point] >= 2) continue;
+      keep[k] = 0;
+      ++jp.gated_observations;
+      if (!counted[point]) ++jp.gated_points, counted[point] = 1;
+    }
+  }
+  std::vector<bool> used(input.map_points.size(), false);
+  for (size_t k = 0; k < observations.size(); ++k) {
+    if (!keep[k]) continue;
+    const VisualObservation& obs = observations[k];
+    double* pose = jp.poses.at(obs.keyframe).data();
+    double* point = jp.map_points[obs.map_point].data();
     const double sigma = std::pow(options.octave_scale_factor, obs.octave);
     ceres::CostFunction* cost =
         options.analytic_jacobians
@@ -124,10 +175,22 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
   }
   for (size_t i = 0; i < used.size(); ++i) {
     if (!used[i]) continue;
-    if (options.optimize_map_points) {
-      jp.has_free_map_points = true;
-    } else {
+    bool hold = !options.optimize_map_points;
+    if (!hold && check_weak) {
+      // lambda_min <= 0 (a single ray, or all rays parallel) means an unbounded sigma.
+      const double lambda_min = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                                    information[i], Eigen::EigenvaluesOnly)
+                                    .eigenvalues()(0);
+      const double bound = options.max_point_sigma_ratio * nearest[i];
+      if (!(lambda_min * bound * bound > 1.0)) {
+        hold = true;
+        ++jp.weak_points;
+      }
+    }
+    if (hold) {
       jp.problem->SetParameterBlockConstant(jp.map_points[i].data());
+    } else {
+      jp.has_free_map_points = true;
     }
   }
 }
@@ -189,6 +252,8 @@ void JointProblemOptions::Check() const {
   JVL_CHECK(octave_scale_factor >= 1, "octave_scale_factor must be >= 1");
   JVL_CHECK(imls_sigma_m > 0 && direction_sigma_px > 0, "residual sigmas must be positive");
   JVL_CHECK(direction_min_z > 0 && direction_min_z < 1, "direction_min_z must be in (0, 1)");
+  JVL_CHECK(std::isfinite(visual_gate_chi2), "visual_gate_chi2 must be finite");
+  JVL_CHECK(std::isfinite(max_point_sigma_ratio), "max_point_sigma_ratio must be finite");
   JVL_CHECK(
       std::isfinite(visual_huber) && std::isfinite(imls_huber) && std::isfinite(direction_huber),
       "Huber thresholds must be finite");

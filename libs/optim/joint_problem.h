@@ -104,6 +104,18 @@ struct JointProblemOptions {
   double imls_huber = 0.0;
   double direction_huber = 0.0;
   double direction_min_z = 0.05;  // clamp of DirectionProjectionCost (see cost_functions.h)
+  // Outlier gate on e_V at the initial estimate (whitened squared reprojection error; <= 0: off).
+  // Observations above it are left out of the problem, and with free map points so is every
+  // point left with fewer than 2 observations (its depth would be unconstrained). ORB-SLAM's
+  // bundle adjustments drop observations above chi2(2, 0.95) = 5.991 the same way.
+  double visual_gate_chi2 = 0.0;
+  // Free map points whose position is poorly determined by their observations at the initial
+  // estimate are held constant (<= 0: off): those whose largest standard deviation
+  // 1 / sqrt(lambda_min(sum J^T J)) (J = d e_V / dX, whitened) exceeds this fraction of their
+  // distance to the nearest observing camera. Such points (far, small parallax, coarse pyramid
+  // levels) let an LM step fling them behind a camera, which fails the evaluation and wastes
+  // the iteration; held constant they still constrain the poses' rotations, as far points do.
+  double max_point_sigma_ratio = 0.0;
   bool optimize_map_points = true;
   bool analytic_jacobians = true;  // analytic e_L / e_D twins (faster, see docs/optimization.md)
   // Without a Huber kernel on e_L, all correspondences of one keyframe pair (n, c) form one exact
@@ -137,6 +149,10 @@ struct JointProblem {
   std::set<int64_t> fixed;  // effective constant poses (gauge)
   JointWeights weights;
   int64_t dropped_observations = 0;  // behind the camera at the initial estimate
+  // Left out by visual_gate_chi2: observations above the gate, and the other observations of
+  // free map points left with fewer than 2 (counted in gated_observations too).
+  int64_t gated_observations = 0, gated_points = 0;
+  int64_t weak_points = 0;  // held constant by max_point_sigma_ratio
   bool has_free_map_points = false;
 };
 
@@ -174,6 +190,8 @@ struct JointSolveResult {
   JointWeights weights;
   int iterations = 0;
   int64_t imls_blocks = 0;  // residual blocks holding the e_L terms (one per pair when summed)
+  // Visual observations left out when the problem was built (JointProblem's counts).
+  int64_t dropped_observations = 0, gated_observations = 0, gated_points = 0, weak_points = 0;
   double time_s = 0.0;
   bool usable = false;      // Ceres returned CONVERGENCE or NO_CONVERGENCE (not FAILURE)
   std::string termination;  // Ceres' summary line

@@ -166,6 +166,86 @@ TEST(JointProblem, DropsObservationsBehindTheCameraAndFixesTheFirstPoseByDefault
   EXPECT_TRUE(result.usable);
 }
 
+TEST(JointProblem, VisualGateLeavesOutOutliersAndPointsWithoutDepth) {
+  ToyRoad toy = MakeToyRoad(false);
+  // Two points seen by keyframes 3 and 4; one observation of each is 40 px off.
+  JointProblemInput& in = toy.input;
+  const int64_t before = static_cast<int64_t>(in.observations.size());
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Vector3d p_w = in.poses[3] * Eigen::Vector3d(-4.0 + 8.0 * i, -1.0, 15.0);
+    const int32_t id = static_cast<int32_t>(in.map_points.size());
+    in.map_points.push_back(p_w);
+    for (int64_t k : {3, 4}) {
+      Eigen::Vector2d uv = in.camera.Project(in.poses[k].Inverse() * p_w);
+      if (k == 4) uv.x() += 40.0;
+      in.observations.push_back({k, id, uv, 0});
+    }
+  }
+  JointProblemOptions options;
+  JointProblem off = BuildJointProblem(in, options);
+  EXPECT_EQ(off.gated_observations, 0);
+  EXPECT_EQ(static_cast<int64_t>(off.visual_blocks.size()), before + 4);
+
+  // Points of the toy seen only once: a free point then has no depth and is left out too.
+  std::map<int32_t, int> seen;
+  for (const auto& o : in.observations) ++seen[o.map_point];
+  const int64_t single = std::count_if(seen.begin(), seen.end(), [](auto& s) { return s.second == 1; });
+  options.visual_gate_chi2 = 5.991;
+  JointProblem free_points = BuildJointProblem(in, options);
+  // The bad observations go, and with them the two points, left with one observation each.
+  EXPECT_EQ(free_points.gated_points, single + 2);
+  EXPECT_EQ(free_points.gated_observations, single + 4);
+  EXPECT_EQ(static_cast<int64_t>(free_points.visual_blocks.size()), before - single);
+
+  options.optimize_map_points = false;  // a fixed point's single observation still holds a pose
+  JointProblem fixed_points = BuildJointProblem(in, options);
+  EXPECT_EQ(fixed_points.gated_points, 0);
+  EXPECT_EQ(fixed_points.gated_observations, 2);
+  EXPECT_EQ(static_cast<int64_t>(fixed_points.visual_blocks.size()), before + 2);
+
+  const JointSolveResult result = SolveJointProblem(free_points, {});
+  EXPECT_TRUE(result.usable);
+  EXPECT_EQ(result.gated_observations, single + 4);
+  EXPECT_EQ(result.gated_points, single + 2);
+  EXPECT_EQ(result.before.visual.count, before - single);
+}
+
+TEST(JointProblem, PointsWithoutDepthInformationAreHeldConstant) {
+  ToyRoad toy = MakeToyRoad(false);
+  JointProblemInput& in = toy.input;
+  // A far point seen by keyframes 3 and 4 (2 m apart, 0.2 deg parallax at 600 m) and a near
+  // one (10 deg at 12 m), both observed exactly.
+  const int32_t far = static_cast<int32_t>(in.map_points.size());
+  in.map_points.push_back(in.poses[3] * Eigen::Vector3d(30.0, -5.0, 600.0));
+  const int32_t near = far + 1;
+  in.map_points.push_back(in.poses[3] * Eigen::Vector3d(2.0, -1.0, 12.0));
+  for (int32_t id : {far, near}) {
+    for (int64_t k : {3, 4}) {
+      const Eigen::Vector3d p_k = in.poses[k].Inverse() * in.map_points[id];
+      in.observations.push_back({k, id, in.camera.Project(p_k), 0});
+    }
+  }
+  JointProblemOptions options;
+  options.visual_gate_chi2 = 5.991;  // also leaves out the toy's single-observation points
+  JointProblem all_free = BuildJointProblem(in, options);
+  EXPECT_EQ(all_free.weak_points, 0);
+  EXPECT_FALSE(all_free.problem->IsParameterBlockConstant(all_free.map_points[far].data()));
+
+  // sigma of the far point along its ray: 600 m * (1 px / 707 px) / (2 m / 600 m) ~ 250 m.
+  options.max_point_sigma_ratio = 0.1;
+  JointProblem held = BuildJointProblem(in, options);
+  EXPECT_TRUE(held.problem->IsParameterBlockConstant(held.map_points[far].data()));
+  EXPECT_FALSE(held.problem->IsParameterBlockConstant(held.map_points[near].data()));
+  EXPECT_GE(held.weak_points, 1);
+  const JointSolveResult result = SolveJointProblem(held, {});
+  EXPECT_TRUE(result.usable);
+  EXPECT_EQ(result.weak_points, held.weak_points);
+  EXPECT_EQ(result.map_points[far], in.map_points[far]);  // held constant
+
+  options.optimize_map_points = false;  // fixed map points: nothing to hold, nothing counted
+  EXPECT_EQ(BuildJointProblem(in, options).weak_points, 0);
+}
+
 TEST(JointProblem, PoseOnlyProblemUsesSparseNormalCholesky) {
   ToyRoad toy = MakeToyRoad(true);
   toy.input.observations.clear();

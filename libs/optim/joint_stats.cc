@@ -118,6 +118,10 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   JointSolveResult result;
   result.weights = jp.weights;
   result.imls_blocks = static_cast<int64_t>(jp.imls_blocks.size());
+  result.dropped_observations = jp.dropped_observations;
+  result.gated_observations = jp.gated_observations;
+  result.gated_points = jp.gated_points;
+  result.weak_points = jp.weak_points;
   result.before = EvaluateJointCost(jp, options.threads);
   ceres::Solver::Options so = MakeSolverOptions(jp, options);
   ProgressLog progress(options.progress_label);

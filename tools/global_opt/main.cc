@@ -70,6 +70,17 @@ int main(int argc, char** argv) {
   cli.add_option("--direction-huber", o.joint.direction_huber,
                  "Huber threshold of e_D in sigmas (<= 0: none)")
       ->capture_default_str();
+  cli.add_option("--visual-gate", o.joint.visual_gate_chi2,
+                 "Leave out visual observations whose squared reprojection error in sigmas "
+                 "exceeds this at the start of a round, and free map points left with < 2 "
+                 "(<= 0: keep all; 5.991 with --max-point-sigma 0.3 makes free map points "
+                 "converge on long sequences, docs/global_opt.md)")
+      ->capture_default_str();
+  cli.add_option("--max-point-sigma", o.joint.max_point_sigma_ratio,
+                 "Hold free map points constant whose position sigma at the start of a round "
+                 "exceeds this fraction of their distance to the nearest observing camera "
+                 "(<= 0: all free)")
+      ->capture_default_str();
   cli.add_flag("!--fixed-map-points", o.joint.optimize_map_points,
                "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only; "
                "several times faster on long sequences, see docs/global_opt.md)");
