@@ -155,7 +155,10 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
       if (!keep[k] || kept_per_point[point] >= 2) continue;
       keep[k] = 0;
       ++jp.gated_observations;
-      if (!counted[point]) ++jp.gated_points, counted[point] = 1;
+      if (!counted[point]) {
+        counted[point] = 1;
+        ++jp.gated_points;
+      }
     }
   }
   std::vector<bool> used(input.map_points.size(), false);
