@@ -53,9 +53,7 @@ bool VisualReprojectionAnalyticCost::Evaluate(double const* const* parameters, d
   residuals[0] = s * (uv_.x() - (fx_ * x_c.x() * inv_z + cx_));
   residuals[1] = s * (uv_.y() - (fy_ * x_c.y() * inv_z + cy_));
   if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) return true;
-  Eigen::Matrix<double, 2, 3> dr_dx;
-  dr_dx << -s * fx_ * inv_z, 0, s * fx_ * x_c.x() * inv_z * inv_z,  //
-      0, -s * fy_ * inv_z, s * fy_ * x_c.y() * inv_z * inv_z;
+  const Eigen::Matrix<double, 2, 3> dr_dx = PixelResidualJacobian(fx_, fy_, s, x_c);
   const Eigen::Matrix<double, 2, 3> dr_dx_rt = dr_dx * q_wc.conjugate().toRotationMatrix();
   if (jacobians[0] != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jacobians[0]);
@@ -118,9 +116,7 @@ bool EvaluateDirection(const PinholeCamera& camera, const Eigen::Vector2d& vp, d
   residuals[0] = s * (vp.x() - (camera.fx * d.x() * inv_z + camera.cx));
   residuals[1] = s * (vp.y() - (camera.fy * d.y() * inv_z + camera.cy));
   if (jac_pose == nullptr && jac_direction == nullptr) return true;
-  Eigen::Matrix<double, 2, 3> dr_dd;
-  dr_dd << -s * camera.fx * inv_z, 0, s * camera.fx * d.x() * inv_z * inv_z,  //
-      0, -s * camera.fy * inv_z, s * camera.fy * d.y() * inv_z * inv_z;
+  Eigen::Matrix<double, 2, 3> dr_dd = PixelResidualJacobian(camera.fx, camera.fy, s, d);
   if (clamped) dr_dd.col(2).setZero();
   if (jac_pose != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jac_pose);

@@ -21,6 +21,17 @@ Eigen::Matrix<double, 3, 4> RotateJacobian(const double* q_xyzw, const Eigen::Ve
 // d(R(q)^T v)/d[qx qy qz qw].
 Eigen::Matrix<double, 3, 4> InverseRotateJacobian(const double* q_xyzw, const Eigen::Vector3d& v);
 
+// dr/dp of a pixel residual r = s (uv - pi(p)) at a camera-frame point p (z > 0):
+// -s [fx/z 0 -fx x/z^2; 0 fy/z -fy y/z^2]. Shared by e_V, e_D and the map-point information.
+inline Eigen::Matrix<double, 2, 3> PixelResidualJacobian(double fx, double fy, double s,
+                                                         const Eigen::Vector3d& p) {
+  const double inv_z = 1.0 / p.z();
+  Eigen::Matrix<double, 2, 3> j;
+  j << -s * fx * inv_z, 0, s * fx * p.x() * inv_z * inv_z,  //
+      0, -s * fy * inv_z, s * fy * p.y() * inv_z * inv_z;
+  return j;
+}
+
 // Analytic twin of VisualReprojectionCost (same residual, same failure behind the camera). Stores
 // the four intrinsics instead of a camera copy: a global problem holds millions of these.
 class VisualReprojectionAnalyticCost : public ceres::SizedCostFunction<2, 7, 3> {

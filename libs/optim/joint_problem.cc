@@ -123,8 +123,8 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
       ++jp.dropped_observations;
       continue;
     }
+    const double sigma = std::pow(options.octave_scale_factor, obs.octave);
     if (options.visual_gate_chi2 > 0) {
-      const double sigma = std::pow(options.octave_scale_factor, obs.octave);
       const Eigen::Vector2d error = (input.camera.Project(x_c) - obs.uv) / sigma;
       if (!(error.squaredNorm() <= options.visual_gate_chi2)) {
         ++jp.gated_observations;
@@ -134,14 +134,9 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
     keep[k] = 1;
     ++kept_per_point[obs.map_point];
     if (check_weak) {
-      const double s = 1.0 / std::pow(options.octave_scale_factor, obs.octave);
-      const double inv_z = 1.0 / x_c.z();
-      Eigen::Matrix<double, 2, 3> j;
-      j << input.camera.fx * inv_z, 0, -input.camera.fx * x_c.x() * inv_z * inv_z,  //
-          0, input.camera.fy * inv_z, -input.camera.fy * x_c.y() * inv_z * inv_z;
-      j *= s;
       const Eigen::Matrix<double, 2, 3> j_w =
-          j * input.poses.at(obs.keyframe).RotationMatrix().transpose();
+          PixelResidualJacobian(input.camera.fx, input.camera.fy, 1.0 / sigma, x_c) *
+          input.poses.at(obs.keyframe).RotationMatrix().transpose();
       information[obs.map_point] += j_w.transpose() * j_w;
       nearest[obs.map_point] = std::min(nearest[obs.map_point], x_c.norm());
     }
