@@ -109,7 +109,8 @@ nlohmann::json DescribeScene(const World& world) {
                 {"half_width_m", sc.options.road_half_width},
                 {"lane_width_m", 3.5},
                 {"sidewalk_width_m", sc.options.sidewalk_width}};
-  j["terrain"] = {{"amplitude", sc.terrain.amplitude},
+  j["terrain"] = {{"scale", sc.options.terrain_scale},
+                  {"amplitude", sc.terrain.amplitude},
                   {"wavelength", sc.terrain.wavelength},
                   {"phase", sc.terrain.phase}};
   nlohmann::json groups = nlohmann::json::array();

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "sim/describe.h"
@@ -52,6 +53,31 @@ TEST(DriveTest, DefaultDemoMeetsTheBrief) {
   EXPECT_GT(world->scene.buildings.size(), 20u);
   // Poses: world = cam0 of frame 0.
   EXPECT_LT(world->ground_truth.world_from_cam[0].translation().norm(), 1e-9);
+}
+
+TEST(TerrainTest, ScaleMultipliesTheHeightsAndZeroIsFlat) {
+  SequenceOptions opt;
+  opt.frames = 5;
+  const auto rolling = BuildWorld(opt);
+  opt.scene.terrain_scale = 0.5;
+  const auto half = BuildWorld(opt);
+  opt.scene.terrain_scale = 0.0;
+  const auto flat = BuildWorld(opt);
+  double max_height = 0;
+  for (double x = -200; x <= 200; x += 13.7) {
+    for (double y = -200; y <= 200; y += 11.3) {
+      const double h = rolling->scene.terrain.Height(x, y);
+      max_height = std::max(max_height, std::abs(h));
+      EXPECT_NEAR(half->scene.terrain.Height(x, y), 0.5 * h, 1e-12);
+      EXPECT_EQ(flat->scene.terrain.Height(x, y), 0.0);
+      EXPECT_EQ(flat->scene.terrain.Gradient(x, y).norm(), 0.0);
+    }
+  }
+  EXPECT_GT(max_height, 1.0);  // The default terrain does roll.
+  EXPECT_EQ(DescribeScene(*flat)["terrain"]["scale"].get<double>(), 0.0);
+  EXPECT_EQ(DescribeScene(*rolling)["terrain"]["scale"].get<double>(), 1.0);
+  opt.scene.terrain_scale = -1;
+  EXPECT_THROW(BuildWorld(opt), std::exception);
 }
 
 TEST(DriveTest, StopHoldsTheVehicle) {

@@ -238,6 +238,8 @@ void SceneOptions::Check() const {
   JVL_CHECK(sidewalk_width >= 0, "sidewalk width must be >= 0");
   JVL_CHECK(ground_cell > 0.2 && ground_cell <= 10, "ground cell must be in (0.2, 10] m");
   JVL_CHECK(moving_cars >= 0, "moving car count must be >= 0");
+  JVL_CHECK(std::isfinite(terrain_scale) && terrain_scale >= 0 && terrain_scale <= 5,
+            "terrain scale must be in [0, 5], got " << terrain_scale);
 }
 
 Box Scene::MovingCarBox(size_t i, double t) const {
@@ -263,9 +265,9 @@ Scene BuildScene(const Route& route, const SceneOptions& options) {
   Scene scene;
   scene.options = options;
   scene.route = route;
-  if (options.scenario == Scenario::kHighway) {
-    for (double& a : scene.terrain.amplitude) a *= 0.6;
-  }
+  const double terrain_scale =
+      options.terrain_scale * (options.scenario == Scenario::kHighway ? 0.6 : 1.0);
+  for (double& a : scene.terrain.amplitude) a *= terrain_scale;
   Rng rng(HashCombine(options.seed, 0x5ce7e));
   PlaceBuildings(scene, rng);
   AssignAxisGroups(scene);

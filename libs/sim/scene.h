@@ -99,6 +99,8 @@ struct SceneOptions {
   double ground_cell = 2.0;  // Terrain mesh resolution (m).
   double ground_margin = 90.0;
   int moving_cars = 4;
+  // Multiplies the terrain amplitudes (0 = flat ground; slopes scale with it).
+  double terrain_scale = 1.0;
   void Check() const;
 };
 

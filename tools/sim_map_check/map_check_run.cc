@@ -52,6 +52,8 @@ sim::SequenceOptions WorldOptionsFromScene(const nlohmann::json& scene, const st
     o.frames = Field(scene, "frames", what).get<int64_t>();
     o.stop = Field(Field(scene, "summary", what), "stop_at_s", what).get<double>() >= 0;
     o.scene.moving_cars = static_cast<int>(Field(scene, "moving_cars", what).size());
+    // Written since the terrain became scalable; older files have the default scale.
+    o.scene.terrain_scale = Field(scene, "terrain", what).value("scale", 1.0);
   } catch (const nlohmann::json::exception& e) {
     JVL_THROW(what << ": unexpected scene description: " << e.what());
   }

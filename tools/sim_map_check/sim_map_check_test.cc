@@ -16,6 +16,7 @@
 #include "map_check_run.h"
 #include "mapping/map_builder.h"
 #include "mapping/summary.h"
+#include "sim/describe.h"
 #include "sim/write_sequence.h"
 
 namespace jvl::tools {
@@ -169,5 +170,27 @@ TEST_F(SimMapCheckTest, CommandLine) {
             0);
 }
 
+// The world is rebuilt with the terrain scale the sequence was made with; files written before
+// the scale existed have none and mean 1.
+TEST(WorldOptionsFromSceneTest, ReadsTheTerrainScale) {
+  sim::SequenceOptions opt;
+  opt.frames = 5;
+  opt.simulate_scans = false;
+  opt.render_images = false;
+  opt.scene.terrain_scale = 0.0;
+  const auto flat = sim::BuildWorld(opt);
+  nlohmann::json scene = sim::DescribeScene(*flat);
+  const sim::SequenceOptions o = WorldOptionsFromScene(scene, "scene.json");
+  EXPECT_EQ(o.scene.terrain_scale, 0.0);
+  const auto rebuilt = sim::BuildWorld(o);
+  EXPECT_NO_THROW(CheckSameWorld(*rebuilt, scene, flat->ground_truth, "scene.json"));
+  scene["terrain"].erase("scale");
+  EXPECT_EQ(WorldOptionsFromScene(scene, "scene.json").scene.terrain_scale, 1.0);
+  // The default (rolling) world is not the flat one.
+  opt.scene.terrain_scale = 1.0;
+  EXPECT_THROW(CheckSameWorld(*sim::BuildWorld(opt), sim::DescribeScene(*flat), flat->ground_truth,
+                              "scene.json"),
+               std::exception);
+}
 }  // namespace
 }  // namespace jvl::tools

@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--moving-cars", opt.scene.moving_cars, "Moving cars on the route")
       ->capture_default_str();
+  cli.add_option("--terrain-scale", opt.scene.terrain_scale,
+                 "Scale of the rolling terrain's heights and slopes (0 = flat, 1 = slopes of a "
+                 "few percent)")
+      ->capture_default_str();
   int64_t preview = -1;
   cli.add_option("--preview-frame", preview,
                  "Also write sim/topview_<frame>.png, a bird's-eye view of that frame's scan");
