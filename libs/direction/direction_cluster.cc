@@ -283,6 +283,15 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
   st.window_kept = int(groups.size());
   groups = SecondLevel(cands, prior, ground, groups, options);
   groups = OnePerFrame(cands, vps, std::move(groups), options.min_size);
+  // Th_delta once more on the final clusters: a first-level cluster passes with the spread of
+  // all its members, but one of its second-level pieces can be a gentle bend elsewhere whose VPs
+  // sweep through the mode's direction and turn with the road (test
+  // BendSweepingThroughAStraightsDirectionIsNoPrior: std 2.1 deg; not a single direction).
+  const size_t before_std = groups.size();
+  groups.erase(std::remove_if(groups.begin(), groups.end(),
+                              [&](const Group& g) { return g.std_deg > options.max_std_deg; }),
+               groups.end());
+  st.level2_too_wide = int(before_std - groups.size());
   st.level2_clusters = int(groups.size());
   // Final ids in order of each cluster's first frame.
   std::vector<std::pair<int64_t, int>> first;

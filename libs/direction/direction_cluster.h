@@ -90,7 +90,8 @@ struct DirectionAssociation {
 
 struct DirectionClusterStats {
   int input_vps = 0, missing_prior = 0, forward_kept = 0, level1_clusters = 0, level1_kept = 0,
-      window_kept = 0, level2_clusters = 0, associations_before_interval = 0, associations = 0;
+      window_kept = 0, level2_too_wide = 0, level2_clusters = 0, associations_before_interval = 0,
+      associations = 0;
 };
 
 struct DirectionClusterResult {

@@ -176,6 +176,39 @@ TEST(DirectionCluster, DriftingPriorStillSeparatesRoadDirections) {
   }
 }
 
+// A gentle bend whose tangent sweeps through the direction of a straight elsewhere: the
+// first-level mode of the straight takes the bend's VPs within max_member_angle, the second
+// level puts them in a piece of their own (far from the straight), and that piece's VPs turn
+// with the road. Th_delta applied to the final clusters drops it.
+TEST(DirectionCluster, BendSweepingThroughAStraightsDirectionIsNoPrior) {
+  // Bend from heading 0 to -8 deg over 80 m, 90 deg left, 100 m, 86 deg right: a 150 m
+  // straight at -4 deg about 100 m to the side of the bend.
+  const SyntheticPath path = MakePath({{80, -8}, {30, 90}, {100, 0}, {30, -86}, {150, 0}});
+  testing::SyntheticVpOptions vo;
+  vo.curve_forward_rate = 0.9;  // The road VP follows the tangent on the bend, without
+  vo.curve_noise_deg = 0.0;     // extra scatter (a smooth road, as in the simulator).
+  const auto vps = testing::SimulateVps(path, testing::KittiCamera(), vo);
+  const DirectionClusterOptions o;
+  const DirectionClusterResult r = ClusterDirections(vps, path.truth, testing::KittiCamera(), o);
+  std::printf("bend: %d clusters, %d dropped as wider than Th_delta\n", r.stats.level2_clusters,
+              r.stats.level2_too_wide);
+  EXPECT_GE(r.stats.level2_too_wide, 1);
+  int on_bend_total = 0;
+  for (const auto& c : r.clusters) {
+    EXPECT_LE(c.std_deg, o.max_std_deg) << "cluster " << c.id;
+    int on_bend = 0;
+    for (const auto& a : r.associations) on_bend += a.cluster == c.id && path.segment[a.frame] == 0;
+    std::printf("  cluster %d: %d associations (%d on the bend), std %.2f deg\n", c.id, c.size,
+                on_bend, c.std_deg);
+    on_bend_total += on_bend;
+  }
+  EXPECT_LE(on_bend_total, 8);  // A few bend VPs may join the straights' clusters at its ends.
+  // The straights are still direction priors.
+  std::set<int> segments;
+  for (const auto& [c, seg] : MajoritySegment(path, r)) segments.insert(seg);
+  EXPECT_TRUE(segments.count(2) && segments.count(4));
+}
+
 TEST(DirectionCluster, VIntervalKeepsAssociationsAtLeastKFramesApart) {
   const SyntheticPath path = TestPath();
   const auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});

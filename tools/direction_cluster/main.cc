@@ -54,6 +54,7 @@ io::DirectionsData ToData(const direction::DirectionClusterResult& r, int v_inte
                {"level1_clusters", s.level1_clusters},
                {"level1_kept", s.level1_kept},
                {"window_kept", s.window_kept},
+               {"level2_too_wide", s.level2_too_wide},
                {"level2_clusters", s.level2_clusters},
                {"associations_before_interval", s.associations_before_interval},
                {"associations", s.associations},
@@ -147,8 +148,10 @@ int main(int argc, char** argv) {
     const auto& s = result.stats;
     spdlog::info(
         "{} VPs, {} pass the forward filter, {} first-level clusters ({} kept, {} after "
-        "Th_m/Th_l), {} direction priors, {} associations ({} before V_interval {})",
+        "Th_m/Th_l), {} direction priors ({} second-level clusters wider than Th_delta dropped), "
+        "{} associations ({} before V_interval {})",
         s.input_vps, s.forward_kept, s.level1_clusters, s.level1_kept, s.window_kept,
-        s.level2_clusters, s.associations, s.associations_before_interval, o.v_interval);
+        s.level2_clusters, s.level2_too_wide, s.associations, s.associations_before_interval,
+        o.v_interval);
   });
 }
