@@ -74,17 +74,19 @@ void WriteLocalMap(const std::string& path, const LocalMapData& d, const Provena
   w.Commit(provenance);
 }
 
-LocalMapData ReadLocalMap(const std::string& path) {
+LocalMapData ReadLocalMap(const std::string& path, LocalMapParts parts) {
   H5Reader r(path, kLocalSchema, kLocalSchemaVersion);
   LocalMapData d;
   d.camera = ReadCameraArray(r, "camera");
   d.keyframes = ReadTrajectoryGroup(r, "keyframes");
-  d.imls_n = r.ReadArray<int32_t>("imls/n");
-  d.imls_c = r.ReadArray<int32_t>("imls/c");
-  d.imls_p_x = r.ReadArray<double>("imls/p_x", 3);
-  d.imls_p_y = r.ReadArray<double>("imls/p_y", 3);
-  d.imls_normal = r.ReadArray<double>("imls/normal", 3);
-  d.mappoint_position = r.ReadArray<double>("mappoints/position", 3);
+  if (parts == LocalMapParts::kAll) {
+    d.imls_n = r.ReadArray<int32_t>("imls/n");
+    d.imls_c = r.ReadArray<int32_t>("imls/c");
+    d.imls_p_x = r.ReadArray<double>("imls/p_x", 3);
+    d.imls_p_y = r.ReadArray<double>("imls/p_y", 3);
+    d.imls_normal = r.ReadArray<double>("imls/normal", 3);
+    d.mappoint_position = r.ReadArray<double>("mappoints/position", 3);
+  }
   d.scan_offset = r.ReadArray<int64_t>("scans/offset");
   d.scan_points = r.ReadArray<float>("scans/points", 3);
   d.scan_normals = r.ReadArray<float>("scans/normals", 3);

@@ -51,7 +51,12 @@ struct LocalMapData {
   void Check(const std::string& what) const;
 };
 
+// What ReadLocalMap reads. kWithoutCorrespondences leaves out the saved IMLS set and the map
+// points (imls_* and mappoint_position stay empty): most of the file on long sequences, and all
+// a map export does not need.
+enum class LocalMapParts { kAll, kWithoutCorrespondences };
+
 void WriteLocalMap(const std::string& path, const LocalMapData& data, const Provenance& provenance);
-LocalMapData ReadLocalMap(const std::string& path);
+LocalMapData ReadLocalMap(const std::string& path, LocalMapParts parts = LocalMapParts::kAll);
 
 }  // namespace jvl::io

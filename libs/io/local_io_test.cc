@@ -76,6 +76,23 @@ TEST(LocalIo, RoundTripAndSchema) {
   fs::remove(path);
 }
 
+TEST(LocalIo, ReadsWithoutCorrespondences) {
+  const LocalMapData d = MakeLocal();
+  const std::string path = TempPath("scans.h5");
+  WriteLocalMap(path, d, Provenance{});
+  const LocalMapData r = ReadLocalMap(path, LocalMapParts::kWithoutCorrespondences);
+  EXPECT_TRUE(r.imls_n.empty() && r.imls_c.empty() && r.imls_p_x.empty() && r.imls_p_y.empty() &&
+              r.imls_normal.empty());
+  EXPECT_TRUE(r.mappoint_position.empty());
+  EXPECT_EQ(r.keyframes.frames, d.keyframes.frames);
+  EXPECT_EQ(r.scan_offset, d.scan_offset);
+  EXPECT_EQ(r.scan_points, d.scan_points);
+  EXPECT_EQ(r.scan_normals, d.scan_normals);
+  EXPECT_EQ(r.stats_frame, d.stats_frame);
+  EXPECT_EQ(r.prior.frames, d.prior.frames);
+  fs::remove(path);
+}
+
 TEST(LocalIo, RejectsInconsistentData) {
   LocalMapData d = MakeLocal();
   d.imls_c = {2};  // Only two keyframes.

@@ -53,7 +53,7 @@ LocalInput ToLocalInput(const io::LocalMapData& d) {
 LocalInput ReadLocalInput(const std::string& path) { return ToLocalInput(io::ReadLocalMap(path)); }
 
 std::vector<mapping::KeyframeScan> ReadLocalScans(const std::string& path) {
-  return ScansOf(io::ReadLocalMap(path));
+  return ScansOf(io::ReadLocalMap(path, io::LocalMapParts::kWithoutCorrespondences));
 }
 
 }  // namespace jvl::global_opt
