@@ -39,6 +39,7 @@ struct SequenceEval {
   Similarity alignment;  // Applied to the (origin-relative) estimate.
   PairedPoses paired;    // After alignment; all ground-truth rows.
   ApeResult ape;
+  ApeComponents ape_components;  // The APE along the path and about the camera axes.
   RpeResult rpe;
   KittiResult kitti;
 };
@@ -55,6 +56,8 @@ struct EstimateEval {
   int64_t frames_matched = 0;
   // Statistics of the per-frame (APE) and per-pair (RPE) errors of all sequences together.
   ErrorStats ape_translation, ape_rotation, rpe_translation, rpe_percent, rpe_rotation;
+  // Signed APE components of all sequences together (see ApeComponents).
+  ErrorStats ape_along, ape_lateral, ape_vertical, ape_pitch, ape_yaw, ape_roll;
   // KITTI pooled over all segments of all sequences (the devkit's multi-sequence score) ...
   KittiResult kitti_pooled;
   // ... and the mean of the per-sequence scores (what many papers print).

@@ -1,5 +1,6 @@
 #include "eval/metrics.h"
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -69,6 +70,51 @@ ApeResult ComputeApe(const PairedPoses& paired) {
   r.translation_stats = ComputeStats(r.translation_m);
   r.rotation_stats = ComputeStats(r.rotation_deg);
   return r;
+}
+
+ApeComponents ComputeApeComponents(const PairedPoses& paired, const Eigen::Vector3d& up) {
+  ApeComponents c;
+  if (paired.size() == 0) return c;
+  c.up = up.norm() > 0 ? up.normalized()
+                       : Eigen::Vector3d(-paired.gt.front().block<3, 1>(0, 1).normalized());
+  JVL_CHECK(c.up.allFinite(), "APE components: the up vector is not finite");
+  const size_t n = paired.size();
+  auto position = [&](size_t i) -> Eigen::Vector3d { return paired.gt[i].block<3, 1>(0, 3); };
+  for (size_t i = 0; i < n; ++i) {
+    if (!paired.has_est[i]) continue;
+    // Direction of travel: from the last row >= 1 m behind to the first row >= 1 m ahead.
+    size_t ahead = i, behind = i;
+    while (ahead + 1 < n && (position(ahead) - position(i)).norm() < 1.0) ++ahead;
+    while (behind > 0 && (position(behind) - position(i)).norm() < 1.0) --behind;
+    Eigen::Vector3d travel = position(ahead) - position(behind);
+    if (travel.norm() < 1.0) travel = paired.gt[i].block<3, 1>(0, 2);  // Standing: camera z.
+    Eigen::Vector3d along = travel - travel.dot(c.up) * c.up;
+    if (along.norm() < 1e-6 * travel.norm()) {
+      ++c.skipped;
+      continue;
+    }
+    along.normalize();
+    const Eigen::Vector3d lateral = c.up.cross(along);
+    const Eigen::Vector3d d = paired.est[i].block<3, 1>(0, 3) - position(i);
+    const Eigen::Matrix3d error =
+        paired.gt[i].block<3, 3>(0, 0).transpose() * paired.est[i].block<3, 3>(0, 0);
+    const Eigen::AngleAxisd aa(error);
+    const Eigen::Vector3d w = aa.angle() * kRadToDeg * aa.axis();
+    c.frames.push_back(paired.frames[i]);
+    c.along_m.push_back(d.dot(along));
+    c.lateral_m.push_back(d.dot(lateral));
+    c.vertical_m.push_back(d.dot(c.up));
+    c.pitch_deg.push_back(w.x());
+    c.yaw_deg.push_back(w.y());
+    c.roll_deg.push_back(w.z());
+  }
+  c.along = ComputeStats(c.along_m);
+  c.lateral = ComputeStats(c.lateral_m);
+  c.vertical = ComputeStats(c.vertical_m);
+  c.pitch = ComputeStats(c.pitch_deg);
+  c.yaw = ComputeStats(c.yaw_deg);
+  c.roll = ComputeStats(c.roll_deg);
+  return c;
 }
 
 RpeUnit ParseRpeUnit(const std::string& name) {

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
+
 #include "core/check.h"
 #include "eval/test_util.h"
 
@@ -43,6 +46,57 @@ TEST(Ape, PureTranslationOffset) {
   EXPECT_NEAR(ape.translation_stats.min, 3.0, 1e-12);
   EXPECT_NEAR(ape.translation_stats.std, 0.0, 1e-12);
   EXPECT_NEAR(ape.rotation_stats.max, 0.0, 1e-6);
+}
+
+// KITTI camera moving along +z (up = -y): lateral (up x along) is -x, i.e. left.
+TEST(ApeComponents, SplitsAlongThePathAndAboutTheCameraAxes) {
+  const PoseSeries gt = testing::StraightLine(30);
+  PoseSeries est = gt;
+  const Eigen::Matrix3d pitch =
+      Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (auto& p : est.poses) {
+    p.block<3, 1>(0, 3) += Eigen::Vector3d(0.3, -0.2, 0.1);  // 0.3 right, 0.2 up, 0.1 ahead.
+    p.topLeftCorner<3, 3>() = p.topLeftCorner<3, 3>() * pitch;
+  }
+  est.poses[7].topLeftCorner<3, 3>() = testing::Yaw(-0.02);  // One frame turned right.
+  const ApeComponents c = ComputeApeComponents(Pair(gt, est));
+  EXPECT_NEAR((c.up - Eigen::Vector3d(0, -1, 0)).norm(), 0.0, 1e-15);
+  ASSERT_EQ(c.along.count, 30);
+  EXPECT_EQ(c.skipped, 0);
+  EXPECT_NEAR(c.along.min, 0.1, 1e-12);
+  EXPECT_NEAR(c.along.max, 0.1, 1e-12);
+  EXPECT_NEAR(c.lateral.rmse, 0.3, 1e-12);
+  EXPECT_NEAR(c.lateral.max, -0.3, 1e-12);  // To the right: negative.
+  EXPECT_NEAR(c.vertical.min, 0.2, 1e-12);
+  EXPECT_NEAR(c.vertical.max, 0.2, 1e-12);
+  EXPECT_NEAR(c.pitch_deg[0], 0.01 * 180 / M_PI, 1e-10);
+  EXPECT_NEAR(c.yaw_deg[0], 0.0, 1e-12);
+  EXPECT_NEAR(c.roll_deg[0], 0.0, 1e-12);
+  EXPECT_NEAR(c.pitch_deg[7], 0.0, 1e-12);
+  EXPECT_NEAR(c.yaw_deg[7], -0.02 * 180 / M_PI, 1e-10);
+  // Up given explicitly: +x as up makes the old vertical offset (-y) lateral.
+  const ApeComponents x = ComputeApeComponents(Pair(gt, est), Eigen::Vector3d(2, 0, 0));
+  EXPECT_NEAR(x.vertical.min, 0.3, 1e-12);
+  EXPECT_NEAR(std::abs(x.lateral.max), 0.2, 1e-12);
+}
+
+TEST(ApeComponents, StandingStillUsesTheCameraAxisAndSkipsTravelAlongUp) {
+  // Not moving: the direction of travel is the camera's z axis.
+  const PoseSeries still = testing::MakeSeries(0, 5, [](int64_t) {
+    return testing::Pose(testing::Yaw(M_PI / 2), Eigen::Vector3d(1, 0, 1));
+  });
+  PoseSeries est = still;
+  for (auto& p : est.poses) p(0, 3) += 0.5;  // Along the turned camera's z (= world +x).
+  const ApeComponents c = ComputeApeComponents(Pair(still, est));
+  EXPECT_NEAR(c.along.rmse, 0.5, 1e-12);
+  EXPECT_NEAR(c.lateral.rmse, 0.0, 1e-12);
+  // Moving straight up (along -y): no direction of travel on the ground.
+  const PoseSeries lift = testing::MakeSeries(0, 6, [](int64_t f) {
+    return testing::Pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, -2.0 * f, 0));
+  });
+  const ApeComponents l = ComputeApeComponents(Pair(lift, lift));
+  EXPECT_EQ(l.skipped, 6);
+  EXPECT_EQ(l.along.count, 0);
 }
 
 TEST(Rpe, ConstantYawDriftByFramesAndMetres) {

@@ -127,6 +127,17 @@ std::string FormatMarkdown(const std::vector<EstimateEval>& estimates, const Eva
   }
   const std::string note = MeanOfSequencesNote(estimates);
   if (!note.empty()) os << "\n" << note;
+  os << "\n## APE along the path and about the camera axes (RMS)\n\n"
+     << "Position error in the ground truth's path frame (along the direction of travel, lateral, "
+        "vertical) and the rotation error about the camera's x, y, z axes (KITTI camera: pitch, "
+        "yaw, roll), after the alignment above.\n\n"
+     << "| estimate | along (m) | lateral (m) | vertical (m) | pitch (deg) | yaw (deg) | roll "
+        "(deg) |\n|---|---:|---:|---:|---:|---:|---:|\n";
+  for (const EstimateEval& e : estimates) {
+    os << "| " << e.label << " | " << Num(e.ape_along.rmse) << " | " << Num(e.ape_lateral.rmse)
+       << " | " << Num(e.ape_vertical.rmse) << " | " << Num(e.ape_pitch.rmse) << " | "
+       << Num(e.ape_yaw.rmse) << " | " << Num(e.ape_roll.rmse) << " |\n";
+  }
   for (const EstimateEval& e : estimates) {
     os << "\n## KITTI error per segment length: " << e.label << "\n\n"
        << "| length (m) | segments | t_rel (%) | r_rel (deg/100m) |\n|---:|---:|---:|---:|\n";
