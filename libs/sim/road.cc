@@ -160,7 +160,8 @@ Scenario ParseScenario(const std::string& name) {
   if (name == "urban") return Scenario::kUrban;
   if (name == "suburban") return Scenario::kSuburban;
   if (name == "highway") return Scenario::kHighway;
-  JVL_THROW("unknown scenario '" << name << "' (expected urban, suburban or highway)");
+  if (name == "straight") return Scenario::kStraight;
+  JVL_THROW("unknown scenario '" << name << "' (expected urban, suburban, highway or straight)");
 }
 
 std::string ToString(Scenario scenario) {
@@ -171,8 +172,14 @@ std::string ToString(Scenario scenario) {
       return "suburban";
     case Scenario::kHighway:
       return "highway";
+    case Scenario::kStraight:
+      return "straight";
   }
   return "?";
+}
+
+bool IsHighwayLike(Scenario scenario) {
+  return scenario == Scenario::kHighway || scenario == Scenario::kStraight;
 }
 
 namespace {
@@ -189,6 +196,8 @@ std::vector<RoadPiece> ScenarioLap(Scenario scenario) {
     case Scenario::kHighway:
       return {Straight(320, 20.0), Turn(20, 600, 20.0), Straight(300, 21.0, true),
               Turn(-15, 700, 20.0), Straight(200, 20.0)};
+    case Scenario::kStraight:
+      return {Straight(1200, 20.5)};
   }
   return {};
 }

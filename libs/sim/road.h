@@ -68,9 +68,14 @@ struct Terrain {
 };
 
 // Scenario presets: route pieces, speeds and density of the world.
-enum class Scenario { kUrban, kSuburban, kHighway };
-Scenario ParseScenario(const std::string& name);  // urban|suburban|highway
+// kStraight: the highway's scenery on one 1.2 km straight (the geometry direction priors are
+// made for: one road direction over the whole drive).
+enum class Scenario { kUrban, kSuburban, kHighway, kStraight };
+Scenario ParseScenario(const std::string& name);  // urban|suburban|highway|straight
 std::string ToString(Scenario scenario);
+// Highway and straight: fast, open scenery (few buildings far from the road, no kerbside
+// furniture, flatter terrain).
+bool IsHighwayLike(Scenario scenario);
 // `laps` > 1 repeats the pieces; every second lap has its turns mirrored (left <-> right), so
 // that the route zigzags on without crossing itself (urban: 9 laps = 4.3 km, 4779 frames).
 std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps = 1);

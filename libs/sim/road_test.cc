@@ -39,6 +39,19 @@ TEST(RouteTest, PiecesJoinContinuously) {
   }
 }
 
+TEST(RouteTest, StraightScenarioIsOneLongStraight) {
+  EXPECT_EQ(ParseScenario("straight"), Scenario::kStraight);
+  EXPECT_EQ(ToString(Scenario::kStraight), "straight");
+  EXPECT_TRUE(IsHighwayLike(Scenario::kStraight) && IsHighwayLike(Scenario::kHighway));
+  EXPECT_FALSE(IsHighwayLike(Scenario::kUrban));
+  EXPECT_THROW(ParseScenario("motorway"), std::exception);
+  const Route route(ScenarioRoute(Scenario::kStraight), Eigen::Vector2d::Zero(), 0.35);
+  ASSERT_EQ(route.pieces().size(), 1u);
+  EXPECT_TRUE(route.pieces().front().IsStraight());
+  EXPECT_NEAR(route.length(), 1200.0, 1e-9);
+  for (double s = 0; s <= route.length(); s += 100) EXPECT_NEAR(route.At(s).heading, 0.35, 1e-12);
+}
+
 TEST(DriveTest, DefaultDemoMeetsTheBrief) {
   SequenceOptions opt;
   const auto world = BuildWorld(opt);

@@ -59,6 +59,7 @@ BuildingStyle StyleFor(Scenario s) {
     case Scenario::kSuburban:
       return {8, 14, 8, 12, 3.0, 0.85, 6, 16, 1, 2, 3.0};
     case Scenario::kHighway:
+    case Scenario::kStraight:
       return {30, 60, 15, 25, 4.0, 1.0, 25, 70, 2, 3, 18.0};
   }
   return {};
@@ -149,7 +150,7 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
     scene.signs.push_back(
         {Eigen::Vector3d(p.x(), p.y(), z + 2.25), rp.heading, Eigen::Vector3d(0.06, 0.75, 0.75)});
   }
-  if (scene.options.scenario == Scenario::kHighway) return;
+  if (IsHighwayLike(scene.options.scenario)) return;
   for (const RoadPiece& piece : scene.route.pieces()) {
     if (!piece.IsStraight() || piece.open) continue;
     for (double side : {-1.0, 1.0}) {
@@ -192,7 +193,7 @@ void PlaceMovingCars(Scene& scene, Rng& rng) {
   for (int i = 0; i < scene.options.moving_cars; ++i) {
     MovingCar car;
     const bool oncoming = i % 2 == 0;
-    const double v = scene.options.scenario == Scenario::kHighway ? 24 : 11;
+    const double v = IsHighwayLike(scene.options.scenario) ? 24 : 11;
     car.speed = oncoming ? -rng.Uniform(0.8 * v, v) : rng.Uniform(v, 1.15 * v);
     car.s0 = oncoming ? rng.Uniform(0.3 * len, 1.3 * len) : rng.Uniform(25, 70) + 60.0 * i;
     car.lateral = oncoming ? 1.75 : -1.75;
@@ -266,7 +267,7 @@ Scene BuildScene(const Route& route, const SceneOptions& options) {
   scene.options = options;
   scene.route = route;
   const double terrain_scale =
-      options.terrain_scale * (options.scenario == Scenario::kHighway ? 0.6 : 1.0);
+      options.terrain_scale * (IsHighwayLike(options.scenario) ? 0.6 : 1.0);
   for (double& a : scene.terrain.amplitude) a *= terrain_scale;
   Rng rng(HashCombine(options.seed, 0x5ce7e));
   PlaceBuildings(scene, rng);

@@ -26,7 +26,9 @@ int main(int argc, char** argv) {
   cli.add_option("--sequence", sequence, "Sequence name (two digits)")->capture_default_str();
   cli.add_option("--frames", opt.frames, "Frames to write (0 = whole route)")
       ->capture_default_str();
-  cli.add_option("--scenario", scenario, "urban, suburban or highway")->capture_default_str();
+  cli.add_option("--scenario", scenario,
+                 "urban, suburban, highway or straight (highway scenery, one 1.2 km straight)")
+      ->capture_default_str();
   cli.add_option("--laps", opt.laps,
                  "Drive the route this many times, every second lap mirrored (long sequences)")
       ->capture_default_str();
