@@ -83,19 +83,14 @@ EstimateEval CombineSequences(std::string label, std::vector<SequenceEval> seque
   EstimateEval e;
   e.label = std::move(label);
   std::vector<const std::vector<double>*> ape_t, ape_r, rpe_t, rpe_p, rpe_r;
-  std::vector<const std::vector<double>*> along, lateral, vertical, pitch, yaw, roll;
+  std::vector<const ApeComponents*> components;
   std::vector<KittiSegment> segments;
   double t_sum = 0, r_sum = 0;
   for (const SequenceEval& s : sequences) {
     e.frames_matched += s.frames_matched;
     ape_t.push_back(&s.ape.translation_m);
     ape_r.push_back(&s.ape.rotation_deg);
-    along.push_back(&s.ape_components.along_m);
-    lateral.push_back(&s.ape_components.lateral_m);
-    vertical.push_back(&s.ape_components.vertical_m);
-    pitch.push_back(&s.ape_components.pitch_deg);
-    yaw.push_back(&s.ape_components.yaw_deg);
-    roll.push_back(&s.ape_components.roll_deg);
+    components.push_back(&s.ape_components);
     rpe_t.push_back(&s.rpe.translation_m);
     rpe_p.push_back(&s.rpe.translation_percent);
     rpe_r.push_back(&s.rpe.rotation_deg);
@@ -105,12 +100,7 @@ EstimateEval CombineSequences(std::string label, std::vector<SequenceEval> seque
   }
   e.ape_translation = PoolStats(ape_t);
   e.ape_rotation = PoolStats(ape_r);
-  e.ape_along = PoolStats(along);
-  e.ape_lateral = PoolStats(lateral);
-  e.ape_vertical = PoolStats(vertical);
-  e.ape_pitch = PoolStats(pitch);
-  e.ape_yaw = PoolStats(yaw);
-  e.ape_roll = PoolStats(roll);
+  e.ape_components = PoolApeComponents(components);
   e.rpe_translation = PoolStats(rpe_t);
   e.rpe_percent = PoolStats(rpe_p);
   e.rpe_rotation = PoolStats(rpe_r);

@@ -57,7 +57,7 @@ struct EstimateEval {
   // Statistics of the per-frame (APE) and per-pair (RPE) errors of all sequences together.
   ErrorStats ape_translation, ape_rotation, rpe_translation, rpe_percent, rpe_rotation;
   // Signed APE components of all sequences together (see ApeComponents).
-  ErrorStats ape_along, ape_lateral, ape_vertical, ape_pitch, ape_yaw, ape_roll;
+  ApeComponentStats ape_components;
   // KITTI pooled over all segments of all sequences (the devkit's multi-sequence score) ...
   KittiResult kitti_pooled;
   // ... and the mean of the per-sequence scores (what many papers print).

@@ -108,13 +108,24 @@ ApeComponents ComputeApeComponents(const PairedPoses& paired, const Eigen::Vecto
     c.yaw_deg.push_back(w.y());
     c.roll_deg.push_back(w.z());
   }
-  c.along = ComputeStats(c.along_m);
-  c.lateral = ComputeStats(c.lateral_m);
-  c.vertical = ComputeStats(c.vertical_m);
-  c.pitch = ComputeStats(c.pitch_deg);
-  c.yaw = ComputeStats(c.yaw_deg);
-  c.roll = ComputeStats(c.roll_deg);
+  static_cast<ApeComponentStats&>(c) = PoolApeComponents({&c});
   return c;
+}
+
+ApeComponentStats PoolApeComponents(const std::vector<const ApeComponents*>& parts) {
+  auto pool = [&](std::vector<double> ApeComponents::*values) {
+    std::vector<const std::vector<double>*> v;
+    for (const ApeComponents* p : parts) v.push_back(&(p->*values));
+    return PoolStats(v);
+  };
+  ApeComponentStats s;
+  s.along = pool(&ApeComponents::along_m);
+  s.lateral = pool(&ApeComponents::lateral_m);
+  s.vertical = pool(&ApeComponents::vertical_m);
+  s.pitch = pool(&ApeComponents::pitch_deg);
+  s.yaw = pool(&ApeComponents::yaw_deg);
+  s.roll = pool(&ApeComponents::roll_deg);
+  return s;
 }
 
 RpeUnit ParseRpeUnit(const std::string& name) {

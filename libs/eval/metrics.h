@@ -43,17 +43,21 @@ ApeResult ComputeApe(const PairedPoses& paired);
 // the rotation vector of R_gt^T R_est, i.e. about the ground-truth camera's x, y, z axes (pitch,
 // yaw, roll for a KITTI camera: x right, y down, z forward). Frames whose direction of travel is
 // along `up` are left out (`skipped`). The stats are of the signed values: rmse is the RMS.
-struct ApeComponents {
+struct ApeComponentStats {
+  ErrorStats along, lateral, vertical, pitch, yaw, roll;
+};
+struct ApeComponents : ApeComponentStats {
   Eigen::Vector3d up = Eigen::Vector3d::Zero();
   std::vector<int64_t> frames;
   std::vector<double> along_m, lateral_m, vertical_m, pitch_deg, yaw_deg, roll_deg;
-  ErrorStats along, lateral, vertical, pitch, yaw, roll;
   int64_t skipped = 0;
 };
 // `up` in the frame of the paired poses; zero: minus the y axis of the first ground-truth
 // camera (KITTI: world -y is up when the first pose is the identity).
 ApeComponents ComputeApeComponents(const PairedPoses& paired,
                                    const Eigen::Vector3d& up = Eigen::Vector3d::Zero());
+// Statistics of the per-frame components of several results together (in the given order).
+ApeComponentStats PoolApeComponents(const std::vector<const ApeComponents*>& parts);
 
 enum class RpeUnit { kFrames, kMetres };
 RpeUnit ParseRpeUnit(const std::string& name);  // frames|m

@@ -64,6 +64,17 @@ nlohmann::json StatsToJson(const ErrorStats& s) {
           {"min", s.min},   {"max", s.max},   {"count", s.count}};
 }
 
+namespace {
+
+// The six component statistics of ApeComponentStats.
+nlohmann::json ComponentsToJson(const ApeComponentStats& c) {
+  return {{"along_m", StatsToJson(c.along)},       {"lateral_m", StatsToJson(c.lateral)},
+          {"vertical_m", StatsToJson(c.vertical)}, {"pitch_deg", StatsToJson(c.pitch)},
+          {"yaw_deg", StatsToJson(c.yaw)},         {"roll_deg", StatsToJson(c.roll)}};
+}
+
+}  // namespace
+
 nlohmann::json SequenceToJson(const SequenceEval& s, const EvalOptions& options) {
   nlohmann::json j;
   j["name"] = s.name;
@@ -76,11 +87,9 @@ nlohmann::json SequenceToJson(const SequenceEval& s, const EvalOptions& options)
   j["ape"] = {{"translation_m", StatsToJson(s.ape.translation_stats)},
               {"rotation_deg", StatsToJson(s.ape.rotation_stats)}};
   const ApeComponents& c = s.ape_components;
-  j["ape"]["components"] = {
-      {"along_m", StatsToJson(c.along)},       {"lateral_m", StatsToJson(c.lateral)},
-      {"vertical_m", StatsToJson(c.vertical)}, {"pitch_deg", StatsToJson(c.pitch)},
-      {"yaw_deg", StatsToJson(c.yaw)},         {"roll_deg", StatsToJson(c.roll)},
-      {"up", {c.up.x(), c.up.y(), c.up.z()}},  {"skipped", c.skipped}};
+  j["ape"]["components"] = ComponentsToJson(c);
+  j["ape"]["components"]["up"] = {c.up.x(), c.up.y(), c.up.z()};
+  j["ape"]["components"]["skipped"] = c.skipped;
   j["rpe"] = RpeToJson(s.rpe.translation_stats, s.rpe.percent_stats, s.rpe.rotation_stats, options);
   j["kitti"] = KittiToJson(s.kitti);
   return j;
@@ -92,10 +101,7 @@ nlohmann::json EstimateToJson(const EstimateEval& e, const EvalOptions& options)
   j["frames_matched"] = e.frames_matched;
   j["ape"] = {{"translation_m", StatsToJson(e.ape_translation)},
               {"rotation_deg", StatsToJson(e.ape_rotation)}};
-  j["ape"]["components"] = {
-      {"along_m", StatsToJson(e.ape_along)},       {"lateral_m", StatsToJson(e.ape_lateral)},
-      {"vertical_m", StatsToJson(e.ape_vertical)}, {"pitch_deg", StatsToJson(e.ape_pitch)},
-      {"yaw_deg", StatsToJson(e.ape_yaw)},         {"roll_deg", StatsToJson(e.ape_roll)}};
+  j["ape"]["components"] = ComponentsToJson(e.ape_components);
   j["rpe"] = RpeToJson(e.rpe_translation, e.rpe_percent, e.rpe_rotation, options);
   // Pooled over all segments of all sequences (devkit); equal to the sequence's for one.
   j["kitti"] = KittiToJson(e.kitti_pooled);

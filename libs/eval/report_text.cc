@@ -134,9 +134,10 @@ std::string FormatMarkdown(const std::vector<EstimateEval>& estimates, const Eva
      << "| estimate | along (m) | lateral (m) | vertical (m) | pitch (deg) | yaw (deg) | roll "
         "(deg) |\n|---|---:|---:|---:|---:|---:|---:|\n";
   for (const EstimateEval& e : estimates) {
-    os << "| " << e.label << " | " << Num(e.ape_along.rmse) << " | " << Num(e.ape_lateral.rmse)
-       << " | " << Num(e.ape_vertical.rmse) << " | " << Num(e.ape_pitch.rmse) << " | "
-       << Num(e.ape_yaw.rmse) << " | " << Num(e.ape_roll.rmse) << " |\n";
+    const ApeComponentStats& c = e.ape_components;
+    os << "| " << e.label << " | " << Num(c.along.rmse) << " | " << Num(c.lateral.rmse) << " | "
+       << Num(c.vertical.rmse) << " | " << Num(c.pitch.rmse) << " | " << Num(c.yaw.rmse) << " | "
+       << Num(c.roll.rmse) << " |\n";
   }
   for (const EstimateEval& e : estimates) {
     os << "\n## KITTI error per segment length: " << e.label << "\n\n"
