@@ -1,9 +1,9 @@
 #include "optim/joint_problem.h"
 
-#include <Eigen/Eigenvalues>
 #include <ceres/loss_function.h>
 #include <ceres/sphere_manifold.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -144,17 +144,12 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
   // A free point with a single observation has no depth information: leave it out.
   const bool gate_points = options.visual_gate_chi2 > 0 && options.optimize_map_points;
   if (gate_points) {
-    std::vector<char> counted(input.map_points.size(), 0);
     for (size_t k = 0; k < observations.size(); ++k) {
-      const int64_t point = observations[k].map_point;
-      if (!keep[k] || kept_per_point[point] >= 2) continue;
+      if (!keep[k] || kept_per_point[observations[k].map_point] >= 2) continue;
       keep[k] = 0;
       ++jp.gated_observations;
-      if (!counted[point]) {
-        counted[point] = 1;
-        ++jp.gated_points;
-      }
     }
+    jp.gated_points = std::count(kept_per_point.begin(), kept_per_point.end(), 1);
   }
   std::vector<bool> used(input.map_points.size(), false);
   for (size_t k = 0; k < observations.size(); ++k) {
@@ -176,9 +171,9 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
     bool hold = !options.optimize_map_points;
     if (!hold && check_weak) {
       // lambda_min <= 0 (a single ray, or all rays parallel) means an unbounded sigma.
-      const double lambda_min = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
-                                    information[i], Eigen::EigenvaluesOnly)
-                                    .eigenvalues()(0);
+      const double lambda_min =
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(information[i], Eigen::EigenvaluesOnly)
+              .eigenvalues()(0);
       const double bound = options.max_point_sigma_ratio * nearest[i];
       if (!(lambda_min * bound * bound > 1.0)) {
         hold = true;
