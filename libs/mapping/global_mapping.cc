@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <unordered_set>
 
 #include "core/check.h"
@@ -73,9 +74,50 @@ void GlobalMappingOptions::Check() const {
   JVL_CHECK(std::isfinite(refit_outlier_deg) && refit_outlier_deg > 0 && refit_outlier_deg < 90,
             "refit outlier threshold must be in (0, 90) degrees, got " << refit_outlier_deg);
   JVL_CHECK(refit_min_support >= 1, "refit minimum support must be >= 1");
+  JVL_CHECK(points_per_keyframe >= 0,
+            "points per keyframe must be >= 0 (0 = all), got " << points_per_keyframe);
   JVL_CHECK(std::isfinite(direction_sigma_px) && std::isfinite(min_direction_sigma_px) &&
                 min_direction_sigma_px > 0,
             "direction sigma must be finite and its minimum positive");
+}
+
+std::vector<optim::VisualObservation> SelectObservations(
+    const std::vector<optim::VisualObservation>& observations, size_t num_points,
+    int per_keyframe) {
+  if (per_keyframe <= 0) return observations;
+  int64_t num_keyframes = 0;
+  std::vector<int32_t> count(num_points, 0);
+  for (const auto& o : observations) {
+    JVL_CHECK(o.map_point >= 0 && static_cast<size_t>(o.map_point) < num_points && o.keyframe >= 0,
+              "observation of map point " << o.map_point << " in keyframe row " << o.keyframe
+                                          << " is out of range");
+    ++count[o.map_point];
+    num_keyframes = std::max(num_keyframes, o.keyframe + 1);
+  }
+  // Keyframe rows of each point (CSR).
+  std::vector<int64_t> start(num_points + 1, 0);
+  for (size_t i = 0; i < num_points; ++i) start[i + 1] = start[i] + count[i];
+  std::vector<int64_t> rows(observations.size());
+  std::vector<int64_t> fill(start.begin(), start.end() - 1);
+  for (const auto& o : observations) rows[fill[o.map_point]++] = o.keyframe;
+  std::vector<int32_t> order(num_points);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int32_t a, int32_t b) { return count[a] > count[b]; });
+  std::vector<int32_t> taken_in(static_cast<size_t>(num_keyframes), 0);
+  std::vector<char> taken(num_points, 0);
+  for (const int32_t p : order) {
+    bool needed = false;
+    for (int64_t k = start[p]; k < start[p + 1] && !needed; ++k)
+      needed = taken_in[static_cast<size_t>(rows[k])] < per_keyframe;
+    if (!needed) continue;
+    taken[p] = 1;
+    for (int64_t k = start[p]; k < start[p + 1]; ++k) ++taken_in[static_cast<size_t>(rows[k])];
+  }
+  std::vector<optim::VisualObservation> kept;
+  for (const auto& o : observations)
+    if (taken[o.map_point]) kept.push_back(o);
+  return kept;
 }
 
 const char* ToString(GlobalMappingOptions::DirectionSource source) {
@@ -362,6 +404,24 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   problem.camera = input.camera;
   problem.fixed = {0};  // gauge: the first keyframe
   problem.map_points = input.map_points;
+  result.input_observations = static_cast<int64_t>(input.observations.size());
+  result.input_points = static_cast<int64_t>(input.map_points.size());
+  if (options.points_per_keyframe > 0) {
+    input.observations = SelectObservations(input.observations, input.map_points.size(),
+                                            options.points_per_keyframe);
+  }
+  result.selected_observations = static_cast<int64_t>(input.observations.size());
+  {
+    std::vector<char> seen(input.map_points.size(), 0);
+    for (const auto& o : input.observations) seen[o.map_point] = 1;
+    result.selected_points = std::count(seen.begin(), seen.end(), 1);
+  }
+  if (options.points_per_keyframe > 0) {
+    spdlog::info("visual term: {} of {} map points ({} of {} observations), at least {} per "
+                 "keyframe",
+                 result.selected_points, result.input_points, result.selected_observations,
+                 result.input_observations, options.points_per_keyframe);
+  }
   problem.shared_observations = &input.observations;
   const DirectionSelection dirs = SelectDirections(input.keyframes, input.directions);
   result.directions_not_keyframe = dirs.not_keyframe;
@@ -444,6 +504,8 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
       }
       result.fresh_imls = static_cast<int64_t>(l.size());
       result.traversal_time_s += t.ElapsedSeconds();
+      spdlog::debug("round {}: fresh IMLS traversal {:.1f} s ({} correspondences)", round + 1,
+                    t.ElapsedSeconds(), l.size());
       if (round == rounds - 1) std::vector<KeyframeScan>().swap(input.scans);  // not needed now
     }
     // Warm-start round without e_D: the report's "before" is still the full energy at the input
@@ -472,6 +534,9 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
     optim::SolveOptions solve = options.solve;
     if (!solve.progress_label.empty())
       solve.progress_label += " round " + std::to_string(round + 1) + "/" + std::to_string(rounds);
+    // Only round 0's costs before and the last round's after are reported.
+    solve.evaluate_before = round == 0;
+    solve.evaluate_after = round == rounds - 1;
     result.solve = optim::OptimizeJoint(problem, joint, solve);
     ReleaseFreeHeapMemory();  // the round's Ceres problem is gone (core/memory.h)
     ++result.rounds;
@@ -547,7 +612,12 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
             {"gated_observations", s.gated_observations},
             {"gated_points", s.gated_points},
             {"max_point_sigma_ratio", o.joint.max_point_sigma_ratio},
-            {"weak_points_held", s.weak_points}}},
+            {"weak_points_held", s.weak_points},
+            {"points_per_keyframe", o.points_per_keyframe},
+            {"input_points", r.input_points},
+            {"selected_points", r.selected_points},
+            {"input_observations", r.input_observations},
+            {"selected_observations", r.selected_observations}}},
           {"directions",
            {{"used", r.directions_used},
             {"not_keyframe", r.directions_not_keyframe},

@@ -100,6 +100,10 @@ struct GlobalMappingOptions {
   // rule then balances whitened residuals.
   double direction_sigma_px = 0.0;
   double min_direction_sigma_px = 0.5;
+  // > 0: the visual term uses a subset of the map points that still gives every keyframe at
+  // least this many observations, or all of its own (SelectObservations): the cost of a
+  // free-map-point solve grows with the observations. 0 = every point.
+  int points_per_keyframe = 0;
   void Check() const;
 };
 
@@ -136,6 +140,9 @@ struct GlobalMappingResult {
   double total_time_s = 0;
   int rounds = 0;
   int total_iterations = 0;  // LM iterations over all rounds (solve.iterations: last round)
+  // GlobalMappingOptions::points_per_keyframe: what the visual term kept of the input.
+  int64_t input_observations = 0, selected_observations = 0;
+  int64_t input_points = 0, selected_points = 0;
 };
 
 // Direction residual inputs: one per keyframe with an association and a finite VP.
@@ -159,6 +166,15 @@ double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& ca
                             const std::vector<Eigen::Vector3d>& free_directions = {});
 
 const char* ToString(GlobalMappingOptions::DirectionSource source);
+
+// Observations of a subset of the map points (`num_points` of them) such that every keyframe
+// keeps min(per_keyframe, its own count) observations: points are visited by decreasing
+// number of observations (longer tracks: more parallax; ties by index) and taken while one of
+// their keyframes has fewer than `per_keyframe` taken; all observations of a taken point are
+// kept, in input order. per_keyframe <= 0 keeps everything. Deterministic.
+std::vector<optim::VisualObservation> SelectObservations(
+    const std::vector<optim::VisualObservation>& observations, size_t num_points,
+    int per_keyframe);
 
 // Eq. (2)-(3) for every keyframe n (in parallel, deterministic): the model is the scans of
 // keyframes within N frames before n, placed with the current poses; up to 9 x samples_per_list

@@ -151,10 +151,28 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
     }
     jp.gated_points = std::count(kept_per_point.begin(), kept_per_point.end(), 1);
   }
+  // Points whose position the kept observations do not determine well (max_point_sigma_ratio).
+  std::vector<char> weak(check_weak ? input.map_points.size() : 0, 0);
+  for (size_t i = 0; i < weak.size(); ++i) {
+    if (kept_per_point[i] == 0 || (gate_points && kept_per_point[i] < 2)) continue;
+    // lambda_min <= 0 (a single ray, or all rays parallel) means an unbounded sigma.
+    const double lambda_min =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(information[i], Eigen::EigenvaluesOnly)
+            .eigenvalues()(0);
+    const double bound = options.max_point_sigma_ratio * nearest[i];
+    if (lambda_min * bound * bound > 1.0) continue;
+    weak[i] = 1;
+    ++jp.weak_points;
+  }
+  const bool drop_weak = check_weak && options.drop_weak_points;
   std::vector<bool> used(input.map_points.size(), false);
   for (size_t k = 0; k < observations.size(); ++k) {
     if (!keep[k]) continue;
     const VisualObservation& obs = observations[k];
+    if (drop_weak && weak[obs.map_point]) {
+      ++jp.gated_observations;
+      continue;
+    }
     double* pose = jp.poses.at(obs.keyframe).data();
     double* point = jp.map_points[obs.map_point].data();
     const double sigma = std::pow(options.octave_scale_factor, obs.octave);
@@ -168,19 +186,7 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
   }
   for (size_t i = 0; i < used.size(); ++i) {
     if (!used[i]) continue;
-    bool hold = !options.optimize_map_points;
-    if (!hold && check_weak) {
-      // lambda_min <= 0 (a single ray, or all rays parallel) means an unbounded sigma.
-      const double lambda_min =
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(information[i], Eigen::EigenvaluesOnly)
-              .eigenvalues()(0);
-      const double bound = options.max_point_sigma_ratio * nearest[i];
-      if (!(lambda_min * bound * bound > 1.0)) {
-        hold = true;
-        ++jp.weak_points;
-      }
-    }
-    if (hold) {
+    if (!options.optimize_map_points || (check_weak && weak[i])) {
       jp.problem->SetParameterBlockConstant(jp.map_points[i].data());
     } else {
       jp.has_free_map_points = true;

@@ -116,6 +116,10 @@ struct JointProblemOptions {
   // levels) let an LM step fling them behind a camera, which fails the evaluation and wastes
   // the iteration; held constant they still constrain the poses' rotations, as far points do.
   double max_point_sigma_ratio = 0.0;
+  // What happens to those points: held constant (false) or left out with their observations
+  // (true; counted in gated_observations). Held, they keep the local map's geometry, drift
+  // included, and pin the rotations to it.
+  bool drop_weak_points = false;
   bool optimize_map_points = true;
   bool analytic_jacobians = true;  // analytic e_L / e_D twins (faster, see docs/optimization.md)
   // Without a Huber kernel on e_L, all correspondences of one keyframe pair (n, c) form one exact
@@ -152,7 +156,7 @@ struct JointProblem {
   // Left out by visual_gate_chi2: observations above the gate, and the other observations of
   // free map points left with fewer than 2 (counted in gated_observations too).
   int64_t gated_observations = 0, gated_points = 0;
-  int64_t weak_points = 0;  // held constant by max_point_sigma_ratio
+  int64_t weak_points = 0;  // held constant or dropped by max_point_sigma_ratio
   bool has_free_map_points = false;
 };
 
@@ -169,6 +173,11 @@ struct SolveOptions {
   // Non-empty: one info log line per LM iteration ("<label> iteration k: cost, time"), the
   // progress of long solves.
   std::string progress_label;
+  // The cost by term before and after the solve (JointSolveResult::before / after; one pass over
+  // all residuals each). A caller that reports only some of them (global rounds) skips the rest;
+  // `after` is always evaluated when the solve fails.
+  bool evaluate_before = true;
+  bool evaluate_after = true;
   void Check() const;
 };
 

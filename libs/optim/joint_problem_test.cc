@@ -242,8 +242,38 @@ TEST(JointProblem, PointsWithoutDepthInformationAreHeldConstant) {
   EXPECT_EQ(result.weak_points, held.weak_points);
   EXPECT_EQ(result.map_points[far], in.map_points[far]);  // held constant
 
+  // Dropped instead: the weak points' observations (the far point's two among them) leave the
+  // problem, the near point stays free.
+  options.drop_weak_points = true;
+  JointProblem dropped = BuildJointProblem(in, options);
+  EXPECT_EQ(dropped.weak_points, held.weak_points);
+  const int64_t left_out =
+      static_cast<int64_t>(held.visual_blocks.size() - dropped.visual_blocks.size());
+  EXPECT_GE(left_out, 2 * held.weak_points);  // every weak point had >= 2 observations
+  EXPECT_EQ(dropped.gated_observations, held.gated_observations + left_out);
+  EXPECT_FALSE(dropped.problem->HasParameterBlock(dropped.map_points[far].data()));
+  EXPECT_FALSE(dropped.problem->IsParameterBlockConstant(dropped.map_points[near].data()));
+  options.drop_weak_points = false;
+
   options.optimize_map_points = false;  // fixed map points: nothing to hold, nothing counted
   EXPECT_EQ(BuildJointProblem(in, options).weak_points, 0);
+}
+
+TEST(JointProblem, CostsBeforeAndAfterAreEvaluatedOnlyWhenAsked) {
+  ToyRoad toy = MakeToyRoad(false);
+  SolveOptions solve;
+  const JointSolveResult both = OptimizeJoint(toy.input, {}, solve);
+  EXPECT_GT(both.before.visual.count, 0);
+  EXPECT_GT(both.after.visual.count, 0);
+  solve.evaluate_before = false;
+  solve.evaluate_after = false;
+  const JointSolveResult none = OptimizeJoint(toy.input, {}, solve);
+  EXPECT_EQ(none.before.visual.count, 0);
+  EXPECT_EQ(none.after.visual.count, 0);
+  EXPECT_EQ(none.before.total, 0.0);
+  // Same solve either way.
+  for (const auto& [id, pose] : both.poses)
+    EXPECT_EQ(pose.translation(), none.poses.at(id).translation());
 }
 
 TEST(JointProblem, PoseOnlyProblemUsesSparseNormalCholesky) {

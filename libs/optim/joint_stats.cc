@@ -122,7 +122,9 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   result.gated_observations = jp.gated_observations;
   result.gated_points = jp.gated_points;
   result.weak_points = jp.weak_points;
-  result.before = EvaluateJointCost(jp, options.threads);
+  Timer phase;
+  if (options.evaluate_before) result.before = EvaluateJointCost(jp, options.threads);
+  const double before_s = phase.ElapsedSeconds();
   ceres::Solver::Options so = MakeSolverOptions(jp, options);
   ProgressLog progress(options.progress_label);
   if (!options.progress_label.empty()) so.callbacks.push_back(&progress);
@@ -137,7 +139,17 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
     result.termination = "no residuals";
   }
   result.linear_solver = ceres::LinearSolverTypeToString(so.linear_solver_type);
-  result.after = EvaluateJointCost(jp, options.threads);
+  phase.Reset();
+  if (options.evaluate_after || !result.usable)
+    result.after = EvaluateJointCost(jp, options.threads);
+  spdlog::debug(
+      "joint solve: cost by term {:.1f} s before, {:.1f} s after; Ceres preprocessor {:.1f} s, "
+      "minimizer {:.1f} s (Jacobians {:.1f} s, residuals {:.1f} s, linear solver {:.1f} s), "
+      "postprocessor {:.1f} s",
+      before_s, phase.ElapsedSeconds(), summary.preprocessor_time_in_seconds,
+      summary.minimizer_time_in_seconds, summary.jacobian_evaluation_time_in_seconds,
+      summary.residual_evaluation_time_in_seconds, summary.linear_solver_time_in_seconds,
+      summary.postprocessor_time_in_seconds);
   for (const auto& [id, block] : jp.poses) result.poses[id] = FromPoseBlock(block);
   result.map_points.reserve(jp.map_points.size());
   for (const auto& p : jp.map_points) result.map_points.emplace_back(p[0], p[1], p[2]);
@@ -148,7 +160,9 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
 
 JointSolveResult OptimizeJoint(const JointProblemInput& input, const JointProblemOptions& options,
                                const SolveOptions& solve_options) {
+  const Timer build;
   JointProblem jp = BuildJointProblem(input, options);
+  spdlog::debug("joint problem built in {:.1f} s", build.ElapsedSeconds());
   return SolveJointProblem(jp, solve_options);
 }
 

@@ -7,6 +7,7 @@
 #include "assemble.h"
 #include "core/check.h"
 #include "core/memory.h"
+#include "core/timer.h"
 #include "io/global_io.h"
 #include "io/ply_io.h"
 #include "io/trajectory_io.h"
@@ -22,6 +23,14 @@ int main(int argc, char** argv) {
   double map_voxel = 0.2;
   bool no_direction = false, map_ascii = false, no_saved = false, no_fresh = false;
   mapping::GlobalMappingOptions o;
+  // Defaults for local_map output (map points consistent with the keyframe poses), which is what
+  // this tool reads; the library's defaults keep every observation and point free. They make the
+  // free-map-point solve converge and fit the time budget on long sequences (docs/global_opt.md,
+  // "Default configuration").
+  o.joint.visual_gate_chi2 = 5.991;      // chi2(2, 0.95)
+  o.joint.max_point_sigma_ratio = 0.3;   // hold poorly determined points
+  o.points_per_keyframe = 200;           // visual term on the longest tracks
+  o.solve.function_tolerance = 1e-5;     // the last 1e-5 of the cost does not move the poses
   auto& cli = tool.cli();
   cli.add_option("--local", local_path, "local artifact (local_map)")->required();
   cli.add_option("--visual", visual_path, "visual artifact (visual_assoc)")->required();
@@ -46,6 +55,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--max-iterations", o.solve.max_iterations,
                  "Levenberg-Marquardt iterations per round")
+      ->capture_default_str();
+  cli.add_option("--function-tolerance", o.solve.function_tolerance,
+                 "LM stops when an iteration lowers the cost by less than this fraction")
       ->capture_default_str();
   cli.add_option("--rounds", o.rounds,
                  "Rounds of (fresh IMLS traversal at the current poses, LM solve)")
@@ -73,13 +85,20 @@ int main(int argc, char** argv) {
   cli.add_option("--visual-gate", o.joint.visual_gate_chi2,
                  "Leave out visual observations whose squared reprojection error in sigmas "
                  "exceeds this at the start of a round, and free map points left with < 2 "
-                 "(<= 0: keep all; 5.991 with --max-point-sigma 0.3 makes free map points "
-                 "converge on long sequences, docs/global_opt.md)")
+                 "(<= 0: keep all; with --max-point-sigma it makes free map points converge on long "
+                 "sequences, docs/global_opt.md)")
       ->capture_default_str();
   cli.add_option("--max-point-sigma", o.joint.max_point_sigma_ratio,
                  "Hold free map points constant whose position sigma at the start of a round "
                  "exceeds this fraction of their distance to the nearest observing camera "
                  "(<= 0: all free)")
+      ->capture_default_str();
+  cli.add_flag("--drop-weak-points", o.joint.drop_weak_points,
+               "Leave the points of --max-point-sigma out (with their observations) instead of "
+               "holding them constant");
+  cli.add_option("--points-per-keyframe", o.points_per_keyframe,
+                 "Visual term on a subset of the map points (longest tracks first) that keeps at "
+                 "least this many observations per keyframe (0 = all points)")
       ->capture_default_str();
   cli.add_flag("!--fixed-map-points", o.joint.optimize_map_points,
                "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only; "
@@ -106,6 +125,7 @@ int main(int argc, char** argv) {
     // moved into it), so they do not add to the peak memory of the solve.
     mapping::GlobalMapInput input;
     Trajectory prior;
+    const Timer reading;
     {
       const auto visual = io::ReadVisualMap(visual_path);
       tool.AddInput(visual_path);
@@ -143,7 +163,9 @@ int main(int argc, char** argv) {
       std::vector<optim::ImlsCorrespondence>().swap(input.saved_imls);
     }
     ReleaseFreeHeapMemory();  // what reading the artifacts allocated and freed (core/memory.h)
+    spdlog::debug("artifacts read and assembled in {:.1f} s", reading.ElapsedSeconds());
     const auto result = mapping::OptimizeGlobal(std::move(input), o);
+    const Timer writing;
     std::map<int64_t, Rigid3d> kf;
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       kf[result.keyframes.frames[i]] = result.keyframes.world_from_cam[i];
@@ -161,6 +183,7 @@ int main(int argc, char** argv) {
                                           global_opt::ReadLocalScans(local_path), map_voxel),
                    !map_ascii);
     }
+    spdlog::debug("outputs written in {:.1f} s", writing.ElapsedSeconds());
     const auto& s = result.solve;
     spdlog::info(
         "{} keyframes, {} frames: {} visual, {} IMLS ({} saved + {} fresh, {} keyframe-pair blocks), {} direction "
