@@ -81,43 +81,48 @@ void GlobalMappingOptions::Check() const {
             "direction sigma must be finite and its minimum positive");
 }
 
-std::vector<optim::VisualObservation> SelectObservations(
-    const std::vector<optim::VisualObservation>& observations, size_t num_points,
-    int per_keyframe) {
-  if (per_keyframe <= 0) return observations;
+int64_t SelectObservations(std::vector<optim::VisualObservation>* observations, size_t num_points,
+                           int per_keyframe) {
   int64_t num_keyframes = 0;
   std::vector<int32_t> count(num_points, 0);
-  for (const auto& o : observations) {
+  for (const auto& o : *observations) {
     JVL_CHECK(o.map_point >= 0 && static_cast<size_t>(o.map_point) < num_points && o.keyframe >= 0,
               "observation of map point " << o.map_point << " in keyframe row " << o.keyframe
                                           << " is out of range");
     ++count[o.map_point];
     num_keyframes = std::max(num_keyframes, o.keyframe + 1);
   }
+  if (per_keyframe <= 0)
+    return std::count_if(count.begin(), count.end(), [](int32_t c) { return c > 0; });
   // Keyframe rows of each point (CSR).
   std::vector<int64_t> start(num_points + 1, 0);
   for (size_t i = 0; i < num_points; ++i) start[i + 1] = start[i] + count[i];
-  std::vector<int64_t> rows(observations.size());
+  std::vector<int64_t> rows(observations->size());
   std::vector<int64_t> fill(start.begin(), start.end() - 1);
-  for (const auto& o : observations) rows[fill[o.map_point]++] = o.keyframe;
+  for (const auto& o : *observations) rows[fill[o.map_point]++] = o.keyframe;
   std::vector<int32_t> order(num_points);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
                    [&](int32_t a, int32_t b) { return count[a] > count[b]; });
   std::vector<int32_t> taken_in(static_cast<size_t>(num_keyframes), 0);
   std::vector<char> taken(num_points, 0);
+  int64_t points = 0;
   for (const int32_t p : order) {
     bool needed = false;
     for (int64_t k = start[p]; k < start[p + 1] && !needed; ++k)
       needed = taken_in[static_cast<size_t>(rows[k])] < per_keyframe;
     if (!needed) continue;
     taken[p] = 1;
+    ++points;
     for (int64_t k = start[p]; k < start[p + 1]; ++k) ++taken_in[static_cast<size_t>(rows[k])];
   }
-  std::vector<optim::VisualObservation> kept;
-  for (const auto& o : observations)
-    if (taken[o.map_point]) kept.push_back(o);
-  return kept;
+  observations->erase(std::remove_if(observations->begin(), observations->end(),
+                                     [&](const optim::VisualObservation& o) {
+                                       return !taken[o.map_point];
+                                     }),
+                      observations->end());
+  observations->shrink_to_fit();
+  return points;
 }
 
 const char* ToString(GlobalMappingOptions::DirectionSource source) {
@@ -406,16 +411,9 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   problem.map_points = input.map_points;
   result.input_observations = static_cast<int64_t>(input.observations.size());
   result.input_points = static_cast<int64_t>(input.map_points.size());
-  if (options.points_per_keyframe > 0) {
-    input.observations = SelectObservations(input.observations, input.map_points.size(),
-                                            options.points_per_keyframe);
-  }
+  result.selected_points = SelectObservations(&input.observations, input.map_points.size(),
+                                              options.points_per_keyframe);
   result.selected_observations = static_cast<int64_t>(input.observations.size());
-  {
-    std::vector<char> seen(input.map_points.size(), 0);
-    for (const auto& o : input.observations) seen[o.map_point] = 1;
-    result.selected_points = std::count(seen.begin(), seen.end(), 1);
-  }
   if (options.points_per_keyframe > 0) {
     spdlog::info("visual term: {} of {} map points ({} of {} observations), at least {} per "
                  "keyframe",
@@ -613,6 +611,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
             {"gated_points", s.gated_points},
             {"max_point_sigma_ratio", o.joint.max_point_sigma_ratio},
             {"weak_points_held", s.weak_points},
+            {"drop_weak_points", o.joint.drop_weak_points},
             {"points_per_keyframe", o.points_per_keyframe},
             {"input_points", r.input_points},
             {"selected_points", r.selected_points},

@@ -167,14 +167,14 @@ double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& ca
 
 const char* ToString(GlobalMappingOptions::DirectionSource source);
 
-// Observations of a subset of the map points (`num_points` of them) such that every keyframe
-// keeps min(per_keyframe, its own count) observations: points are visited by decreasing
+// Keeps the observations of a subset of the map points (`num_points` of them) such that every
+// keyframe keeps min(per_keyframe, its own count) observations: points are visited by decreasing
 // number of observations (longer tracks: more parallax; ties by index) and taken while one of
 // their keyframes has fewer than `per_keyframe` taken; all observations of a taken point are
-// kept, in input order. per_keyframe <= 0 keeps everything. Deterministic.
-std::vector<optim::VisualObservation> SelectObservations(
-    const std::vector<optim::VisualObservation>& observations, size_t num_points,
-    int per_keyframe);
+// kept, in input order. per_keyframe <= 0 keeps everything. Returns the number of map points
+// with an observation left. Deterministic.
+int64_t SelectObservations(std::vector<optim::VisualObservation>* observations, size_t num_points,
+                           int per_keyframe);
 
 // Eq. (2)-(3) for every keyframe n (in parallel, deterministic): the model is the scans of
 // keyframes within N frames before n, placed with the current poses; up to 9 x samples_per_list

@@ -324,6 +324,13 @@ TEST(GlobalMapping, BadInputIsOneClearError) {
   EXPECT_THROW(OptimizeGlobal(syn.input, Quiet()), Error);
 }
 
+// SelectObservations on a copy.
+std::vector<optim::VisualObservation> Selected(std::vector<optim::VisualObservation> obs,
+                                               size_t num_points, int per_keyframe) {
+  SelectObservations(&obs, num_points, per_keyframe);
+  return obs;
+}
+
 std::vector<int32_t> PointsOf(const std::vector<optim::VisualObservation>& obs) {
   std::vector<int32_t> points;
   for (const auto& o : obs) points.push_back(o.map_point);
@@ -336,17 +343,17 @@ TEST(GlobalMapping, SelectObservationsTakesTheLongestTracksUntilEveryKeyframeHas
   for (const auto& [kf, p] : std::vector<std::pair<int64_t, int32_t>>{
            {0, 0}, {0, 1}, {0, 2}, {1, 0}, {1, 1}, {1, 4}, {2, 0}, {2, 3}, {2, 4}})
     obs.push_back({kf, p, {10.0 * p, 5.0 * kf}, 0});
-  EXPECT_EQ(PointsOf(SelectObservations(obs, 5, 0)), PointsOf(obs));
-  EXPECT_EQ(PointsOf(SelectObservations(obs, 5, 9)), PointsOf(obs));
+  EXPECT_EQ(PointsOf(Selected(obs, 5, 0)), PointsOf(obs));
+  EXPECT_EQ(PointsOf(Selected(obs, 5, 9)), PointsOf(obs));
   // K = 1: p0 alone gives every keyframe one observation.
-  EXPECT_EQ(PointsOf(SelectObservations(obs, 5, 1)), (std::vector<int32_t>{0, 0, 0}));
+  EXPECT_EQ(PointsOf(Selected(obs, 5, 1)), (std::vector<int32_t>{0, 0, 0}));
   // K = 2: then p1 (keyframes 0, 1 below 2), then p4 (keyframe 2); p2 and p3 are not needed.
-  const auto two = SelectObservations(obs, 5, 2);
+  const auto two = Selected(obs, 5, 2);
   EXPECT_EQ(PointsOf(two), (std::vector<int32_t>{0, 1, 0, 1, 4, 0, 4}));
   EXPECT_EQ(two[4].uv, obs[5].uv);  // the observations themselves, in input order
   std::vector<optim::VisualObservation> bad = obs;
   bad.push_back({0, 7, {0, 0}, 0});
-  EXPECT_THROW(SelectObservations(bad, 5, 2), Error);
+  EXPECT_THROW(SelectObservations(&bad, 5, 2), Error);
 }
 
 TEST(GlobalMapping, SelectObservationsKeepsEnoughInEveryKeyframeDeterministically) {
@@ -360,8 +367,8 @@ TEST(GlobalMapping, SelectObservationsKeepsEnoughInEveryKeyframeDeterministicall
       obs.push_back({k, p, {1.0 * p, 1.0 * k}, 0});
   }
   for (int per_keyframe : {1, 20, 100, 1000}) {
-    const auto kept = SelectObservations(obs, points, per_keyframe);
-    EXPECT_EQ(PointsOf(kept), PointsOf(SelectObservations(obs, points, per_keyframe)));
+    const auto kept = Selected(obs, points, per_keyframe);
+    EXPECT_EQ(PointsOf(kept), PointsOf(Selected(obs, points, per_keyframe)));
     std::vector<int> all(keyframes, 0), taken(keyframes, 0);
     for (const auto& o : obs) ++all[o.keyframe];
     for (const auto& o : kept) ++taken[o.keyframe];
