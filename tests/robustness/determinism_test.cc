@@ -58,17 +58,18 @@ TEST_F(DeterminismTest, TwoThreadsMatchOneThread) {
   ASSERT_EQ(files, FilesUnder(kDir + "run_t2"));
   // local_map and global_opt solve with multi-threaded Ceres, whose Schur complement sums in
   // thread order: their outputs (and what evaluate computes from them) differ in the last bits
-  // from run to run. Measured: local poses ~1e-13, map points up to 4e-5 m, costs up to 2.2e-8
-  // relative (the free direction blocks of global_opt), global poses up to 1.3e-9 m (its default
-  // solve stops at a relative cost change of 1e-5, before the differences are damped out). The
-  // tolerances below leave a margin of 25x or more; every other
+  // from run to run. Measured: local poses ~1e-13, and up to 1.7e-8 m in about one run of five
+  // under load (ctest -j2: a different thread schedule), map points up to 4e-5 m, costs up to
+  // 2.2e-8 relative (the free direction blocks of global_opt), global poses up to 1.3e-9 m (its
+  // default solve stops at a relative cost change of 1e-5, before the differences are damped
+  // out). The pose tolerances leave a margin of about 6x, the others 25x or more; every other
   // output must be identical. map.ply is a voxel map of the poses: a point may move to the
   // next voxel, so only its presence is checked.
   struct Tolerance {
     double abs, rel;
   };
   const std::map<std::string, Tolerance> tolerance = {
-      {"local.h5", {1e-3, 1e-9}}, {"local.txt", {1e-9, 0}},       {"global.h5", {1e-6, 1e-6}},
+      {"local.h5", {1e-3, 1e-9}}, {"local.txt", {1e-7, 0}},       {"global.h5", {1e-6, 1e-6}},
       {"global.txt", {1e-7, 0}},  {"metrics.json", {1e-6, 1e-6}}, {"metrics.md", {1e-6, 0}}};
   for (const std::string& f : files) {
     if (f == "map.ply") continue;
