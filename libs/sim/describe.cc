@@ -109,6 +109,12 @@ nlohmann::json DescribeScene(const World& world) {
                 {"half_width_m", sc.options.road_half_width},
                 {"lane_width_m", 3.5},
                 {"sidewalk_width_m", sc.options.sidewalk_width}};
+  const CameraOptions& cam = world.options.camera;
+  j["camera"] = {{"pixel_noise", cam.pixel_noise},
+                 {"exposure_variation", cam.exposure_variation},
+                 {"blur_sigma", cam.blur_sigma},
+                 {"supersample", cam.supersample},
+                 {"supersample_contrast", cam.supersample_contrast}};
   j["terrain"] = {{"scale", sc.options.terrain_scale},
                   {"amplitude", sc.terrain.amplitude},
                   {"wavelength", sc.terrain.wavelength},

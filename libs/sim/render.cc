@@ -58,11 +58,14 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
   for (const Box& b : moving) {
     if (b.size.x() > 0 && (b.center - o).norm() < 200) near.push_back(b);
   }
+  // Pass 1: one ray through every pixel centre.
   cv::Mat radiance(camera.height, camera.width, CV_32F);
+  cv::Mat surface(camera.height, camera.width, CV_32S);  // What the centre ray hits.
   Eigen::Vector3d dirs[8];
   Hit hits[8];
   for (int j = 0; j < camera.height; ++j) {
     float* row = radiance.ptr<float>(j);
+    int32_t* id = surface.ptr<int32_t>(j);
     for (int i0 = 0; i0 < camera.width; i0 += 8) {
       const int n = std::min(8, camera.width - i0);
       for (int k = 0; k < n; ++k) {
@@ -72,6 +75,64 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
       for (int k = 0; k < n; ++k) {
         IntersectBoxes(near, o, dirs[k], &hits[k]);
         row[i0 + k] = static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, options));
+        id[i0 + k] = hits[k].dynamic >= 0 ? -2 - hits[k].dynamic : hits[k].face;
+      }
+    }
+  }
+  const int ss = options.supersample;
+  if (ss > 1) {
+    // Pass 2: a pixel whose 3 x 3 neighbourhood sees another surface or differs by more than
+    // supersample_contrast grey levels is replaced by the mean of ss x ss rays spread over its
+    // area (the pixel integrates the light falling on it); elsewhere the centre ray stands for
+    // the pixel.
+    const cv::Mat centre = radiance.clone();
+    const float contrast = static_cast<float>(options.supersample_contrast);
+    const float weight = 1.0f / static_cast<float>(ss * ss);
+    std::vector<int> columns;
+    std::vector<Eigen::Vector2d> offsets;
+    for (int sy = 0; sy < ss; ++sy) {
+      for (int sx = 0; sx < ss; ++sx) {
+        offsets.emplace_back((sx + 0.5) / ss - 0.5, (sy + 0.5) / ss - 0.5);
+      }
+    }
+    for (int j = 0; j < camera.height; ++j) {
+      columns.clear();
+      for (int i = 0; i < camera.width; ++i) {
+        const float c = centre.at<float>(j, i);
+        const int32_t f = surface.at<int32_t>(j, i);
+        bool refine = false;
+        for (int y = std::max(0, j - 1); y <= std::min(camera.height - 1, j + 1) && !refine; ++y) {
+          const float* cr = centre.ptr<float>(y);
+          const int32_t* sr = surface.ptr<int32_t>(y);
+          for (int x = std::max(0, i - 1); x <= std::min(camera.width - 1, i + 1); ++x) {
+            if (sr[x] != f || std::abs(cr[x] - c) > contrast) {
+              refine = true;
+              break;
+            }
+          }
+        }
+        if (refine) columns.push_back(i);
+      }
+      // Sub-pixel rays of the marked pixels, eight at a time.
+      float* row = radiance.ptr<float>(j);
+      for (int i : columns) row[i] = 0;
+      const int64_t total = static_cast<int64_t>(columns.size()) * ss * ss;
+      int pixel[8];
+      for (int64_t r0 = 0; r0 < total; r0 += 8) {
+        const int n = static_cast<int>(std::min<int64_t>(8, total - r0));
+        for (int k = 0; k < n; ++k) {
+          const int64_t r = r0 + k;
+          pixel[k] = columns[static_cast<size_t>(r / (ss * ss))];
+          const Eigen::Vector2d& d = offsets[static_cast<size_t>(r % (ss * ss))];
+          dirs[k] =
+              (R * camera.Unproject(Eigen::Vector2d(pixel[k] + d.x(), j + d.y()))).normalized();
+        }
+        caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
+        for (int k = 0; k < n; ++k) {
+          IntersectBoxes(near, o, dirs[k], &hits[k]);
+          row[pixel[k]] +=
+              weight * static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, options));
+        }
       }
     }
   }

@@ -118,6 +118,57 @@ TEST(RenderTest, KnownPointProjectsToTheRightPixel) {
   }
 }
 
+// A pixel integrates the light over its area: the grey levels across a straight edge tell where
+// the edge lies within the pixel, which one ray per pixel centre cannot (it quantises the edge
+// to the pixel grid and the patch alignment of visual_assoc then has nothing to refine).
+TEST(RenderTest, SupersamplingEncodesTheSubPixelEdgePosition) {
+  const PinholeCamera cam = KittiCalibration().Camera(0);
+  const Rigid3d world_from_cam;
+  const double depth = 10.0;
+  const int row = 180;
+  CameraOptions opt;
+  opt.pixel_noise = 0;
+  opt.blur_sigma = 0;
+  // A plate facing the camera at `z` (behind it for z < 0: sky only) from x0 to x0 + 10 m.
+  const auto render = [&](double x0, double z, int supersample) {
+    Scene scene;
+    Mesh local;
+    AddBox(local, Eigen::Vector2d(x0 + 5, z), 0.0, 10.0, 0.002, -3, 3, 0.0, Material::kCar,
+           Material::kCar, -1, 0.0f);
+    // Boxes are built with z up: (x, y, z) -> camera (x, z, y).
+    for (const auto& v : local.vertices) scene.mesh.AddVertex(Eigen::Vector3d(v.x(), v.z(), v.y()));
+    scene.mesh.triangles = local.triangles;
+    scene.mesh.triangle_face = local.triangle_face;
+    scene.mesh.faces = local.faces;
+    const RayCaster caster(scene.mesh);
+    opt.supersample = supersample;
+    return RenderImage(scene, caster, cam, world_from_cam, {}, 1.0, 1, opt);
+  };
+  const cv::Mat sky = render(0.0, -depth, 1);
+  // Edge position from the covered fraction of each pixel of one row: pixel u covers
+  // [u - 0.5, u + 0.5], so the fractions of a plate reaching the right border from x_e sum to
+  // (W - 0.5) - x_e.
+  const auto edge = [&](double u_edge, int supersample) {
+    const cv::Mat img = render(depth * (u_edge - cam.cx) / cam.fx, depth, supersample);
+    const double plate = img.at<uint8_t>(row, img.cols - 5);
+    double covered = 0;
+    for (int u = 0; u < img.cols; ++u) {
+      const double background = sky.at<uint8_t>(row, u);
+      covered +=
+          std::clamp((background - img.at<uint8_t>(row, u)) / (background - plate), 0.0, 1.0);
+    }
+    return (img.cols - 0.5) - covered;
+  };
+  double worst_point = 0, worst_area = 0;
+  for (double u = 600.0; u < 601.0; u += 0.125) {
+    worst_point = std::max(worst_point, std::abs(edge(u, 1) - u));
+    worst_area = std::max(worst_area, std::abs(edge(u, 3) - u));
+  }
+  // 3 x 3 rays: the covered fraction in steps of 1/3, so within 1/6 px (+ grey rounding).
+  EXPECT_LT(worst_area, 0.2);
+  EXPECT_GT(worst_point, 0.4);  // One ray: anywhere within the pixel.
+}
+
 TEST(RenderTest, FeaturesLandOnStructure) {
   const auto world = SmallWorld(0.02, 0.02);
   const SimFrame f = SimulateFrame(*world, 10);

@@ -42,6 +42,13 @@ int main(int argc, char** argv) {
                "Move the LiDAR during the 0.1 s sweep");
   cli.add_option("--pixel-noise", opt.camera.pixel_noise, "Image noise sigma (grey levels)")
       ->capture_default_str();
+  cli.add_option("--supersample", opt.camera.supersample,
+                 "Camera rays per pixel along each axis (the pixel area is averaged)")
+      ->capture_default_str();
+  cli.add_option("--supersample-contrast", opt.camera.supersample_contrast,
+                 "Grey levels between neighbouring pixel centres above which a pixel is "
+                 "supersampled (negative: every pixel)")
+      ->capture_default_str();
   cli.add_option("--exposure-variation", opt.camera.exposure_variation,
                  "Relative frame-to-frame exposure change")
       ->capture_default_str();
