@@ -44,6 +44,33 @@ void UpdateCentre(const std::vector<Candidate>& cands, Group* g) {
   g->std_deg = g->members.empty() ? 0 : std::sqrt(sq / g->members.size());
 }
 
+// How far the ground headings of a cluster's members turn along the path: the slope of the
+// least-squares line heading(s) (heading relative to the centre, s the travelled distance at the
+// member's frame) times the cluster's path length. 0 when the members do not spread along the
+// path.
+double HeadingSweepDeg(const std::vector<Candidate>& cands, const std::vector<double>& path,
+                       const GroundFrame& ground, const Group& g) {
+  const Eigen::Vector2d c = ground.Project(g.centre).normalized();
+  double n = 0, ms = 0, mh = 0;
+  std::vector<std::pair<double, double>> sh;
+  for (int m : g.members) {
+    const Eigen::Vector2d d = ground.Project(cands[m].d);
+    const double h = std::atan2(c.x() * d.y() - c.y() * d.x(), c.dot(d)) / kDeg;
+    const double s = path[cands[m].pose];
+    sh.push_back({s, h});
+    n += 1, ms += s, mh += h;
+  }
+  if (n < 2) return 0;
+  ms /= n, mh /= n;
+  double sss = 0, ssh = 0, lo = sh.front().first, hi = lo;
+  for (const auto& [s, h] : sh) {
+    sss += (s - ms) * (s - ms);
+    ssh += (s - ms) * (h - mh);
+    lo = std::min(lo, s), hi = std::max(hi, s);
+  }
+  return sss > 1e-12 ? std::abs(ssh / sss) * (hi - lo) : 0.0;
+}
+
 // Step 1 and Alg. 2 lines 2-8: world directions and the forward filter.
 std::vector<Candidate> ForwardFilter(const std::vector<VpObservation>& vps, const Trajectory& prior,
                                      const PinholeCamera& camera, const GroundFrame& ground,
@@ -241,6 +268,7 @@ void DirectionClusterOptions::Check() const {
   JVL_CHECK(max_member_angle_deg > 0, "direction: max member angle must be > 0 deg");
   JVL_CHECK(slope_subset_deg >= 0, "direction: slope subset width must be >= 0 deg");
   JVL_CHECK(max_std_deg > 0, "direction: max std (Th_delta) must be > 0 deg");
+  JVL_CHECK(max_sweep_deg > 0, "direction: max sweep must be > 0 deg");
   JVL_CHECK(min_size >= 1, "direction: min size (Th_n) must be >= 1");
   JVL_CHECK(clusters_per_window >= 1, "direction: clusters per window (Th_m) must be >= 1");
   JVL_CHECK(window_length_m > 0, "direction: window length (Th_l) must be > 0 m");
@@ -279,7 +307,8 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
   const std::vector<Candidate> cands = ForwardFilter(vps, prior, camera, ground, options, &st);
   st.forward_kept = int(cands.size());
   std::vector<Group> groups = FirstLevel(cands, ground, options, &st);
-  groups = KeepPerWindow(cands, PathLength(prior), std::move(groups), options);
+  const std::vector<double> path = PathLength(prior);
+  groups = KeepPerWindow(cands, path, std::move(groups), options);
   st.window_kept = int(groups.size());
   groups = SecondLevel(cands, prior, ground, groups, options);
   groups = OnePerFrame(cands, vps, std::move(groups), options.min_size);
@@ -292,6 +321,16 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
                               [&](const Group& g) { return g.std_deg > options.max_std_deg; }),
                groups.end());
   st.level2_too_wide = int(before_std - groups.size());
+  // A bend can also pass Th_delta when it is short: its VPs spread little about their mean but
+  // turn steadily with the road. Such a cluster is dropped by the sweep of its headings.
+  const size_t before_sweep = groups.size();
+  groups.erase(std::remove_if(groups.begin(), groups.end(),
+                              [&](const Group& g) {
+                                return HeadingSweepDeg(cands, path, ground, g) >
+                                       options.max_sweep_deg;
+                              }),
+               groups.end());
+  st.level2_turning = int(before_sweep - groups.size());
   st.level2_clusters = int(groups.size());
   // Final ids in order of each cluster's first frame.
   std::vector<std::pair<int64_t, int>> first;
@@ -311,6 +350,7 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
     info.members = int(g.members.size());
     info.level1 = g.level1;
     info.slope_deg = SlopeDeg(ground, g.centre);
+    info.sweep_deg = HeadingSweepDeg(cands, path, ground, g);
     result.clusters.push_back(info);
     for (int m : g.members) {
       const VpObservation& vp = vps[cands[m].vp];

@@ -54,7 +54,10 @@ struct DirectionClusterOptions {
   double max_member_angle_deg = 4.0;
   // Clusters whose centre slopes (ground heading mod 180 deg) are within this form one subset.
   double slope_subset_deg = 5.0;
-  double max_std_deg = 1.5;     // Th_delta: max RMS angle of the members to the centre.
+  double max_std_deg = 1.5;  // Th_delta: max RMS angle of the members to the centre.
+  // A final cluster whose members' ground headings turn steadily along the path by more than
+  // this (deg, least-squares line over the cluster's path length) is a bend, not a direction.
+  double max_sweep_deg = 2.5;
   int min_size = 10;            // Th_n: min members of a kept cluster (also after each later step).
   int clusters_per_window = 1;  // Th_m: clusters kept per window of travelled distance.
   double window_length_m = 20.0;  // Th_l: window length (m of travelled path).
@@ -77,6 +80,7 @@ struct DirectionClusterInfo {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // Mean prior position of associations.
   int level1 = 0;        // First-level cluster it came from (diagnostic).
   double slope_deg = 0;  // Ground heading of `direction` mod 180 deg.
+  double sweep_deg = 0;  // Turn of the members' headings along the path (max_sweep_deg).
 };
 
 struct DirectionAssociation {
@@ -90,8 +94,8 @@ struct DirectionAssociation {
 
 struct DirectionClusterStats {
   int input_vps = 0, missing_prior = 0, forward_kept = 0, level1_clusters = 0, level1_kept = 0,
-      window_kept = 0, level2_too_wide = 0, level2_clusters = 0, associations_before_interval = 0,
-      associations = 0;
+      window_kept = 0, level2_too_wide = 0, level2_turning = 0, level2_clusters = 0,
+      associations_before_interval = 0, associations = 0;
 };
 
 struct DirectionClusterResult {

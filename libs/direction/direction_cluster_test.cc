@@ -209,6 +209,45 @@ TEST(DirectionCluster, BendSweepingThroughAStraightsDirectionIsNoPrior) {
   EXPECT_TRUE(segments.count(2) && segments.count(4));
 }
 
+// A long gentle bend (40 deg over 200 m) between two straights: its road VPs turn with the
+// tangent, and mean-shift cuts the sweep into pieces a few degrees wide, with a spread below
+// Th_delta (here std 1.1 deg; 1.3-1.4 deg on the simulator's demo drive, frames 277-314). The
+// steady turn of their headings along the path drops them; the straights stay direction priors
+// (the ends of the bend within max_member_angle of a straight join it, as before).
+TEST(DirectionCluster, PiecesOfALongBendTurnAndAreNoPriors) {
+  const SyntheticPath path = MakePath({{120, 0}, {200, 40}, {120, 0}});
+  testing::SyntheticVpOptions vo;
+  vo.curve_forward_rate = 0.9;
+  vo.curve_noise_deg = 0.0;
+  const auto vps = testing::SimulateVps(path, testing::KittiCamera(), vo);
+  DirectionClusterOptions o;
+  o.max_sweep_deg = 1e9;  // Without the sweep test: pieces of the bend are priors.
+  const DirectionClusterResult without =
+      ClusterDirections(vps, path.truth, testing::KittiCamera(), o);
+  o = DirectionClusterOptions();
+  const DirectionClusterResult r = ClusterDirections(vps, path.truth, testing::KittiCamera(), o);
+  const auto on_bend = [&](const DirectionClusterResult& res, int id) {
+    int n = 0;
+    for (const auto& a : res.associations) n += a.cluster == id && path.segment[a.frame] == 1;
+    return n;
+  };
+  int bend_priors = 0;
+  for (const auto& c : without.clusters) {
+    std::printf("without the sweep test: cluster %d, %d associations (%d on the bend), std %.2f\n",
+                c.id, c.size, on_bend(without, c.id), c.std_deg);
+    bend_priors += on_bend(without, c.id) > c.size / 2;
+  }
+  EXPECT_GE(bend_priors, 1);
+  std::printf("with: %d clusters, %d turning\n", r.stats.level2_clusters, r.stats.level2_turning);
+  EXPECT_GE(r.stats.level2_turning, bend_priors);
+  for (const auto& c : r.clusters) {
+    EXPECT_LE(on_bend(r, c.id), c.size / 5) << "cluster " << c.id;
+  }
+  std::set<int> segments;
+  for (const auto& [c, seg] : MajoritySegment(path, r)) segments.insert(seg);
+  EXPECT_TRUE(segments.count(0) && segments.count(2));
+}
+
 TEST(DirectionCluster, VIntervalKeepsAssociationsAtLeastKFramesApart) {
   const SyntheticPath path = TestPath();
   const auto vps = testing::SimulateVps(path, testing::KittiCamera(), {});

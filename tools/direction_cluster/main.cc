@@ -55,6 +55,7 @@ io::DirectionsData ToData(const direction::DirectionClusterResult& r, int v_inte
                {"level1_kept", s.level1_kept},
                {"window_kept", s.window_kept},
                {"level2_too_wide", s.level2_too_wide},
+               {"level2_turning", s.level2_turning},
                {"level2_clusters", s.level2_clusters},
                {"associations_before_interval", s.associations_before_interval},
                {"associations", s.associations},
@@ -103,6 +104,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   cli.add_option("--slope-subset", o.slope_subset_deg, "Slope gap (deg) that separates subsets")
       ->capture_default_str();
+  cli.add_option("--max-sweep", o.max_sweep_deg,
+                 "Max turn of a direction prior's VP headings along its path (deg; larger: a "
+                 "bend)")
+      ->capture_default_str();
   cli.add_option("--th-delta", o.max_std_deg, "Th_delta: max cluster std (deg)")
       ->capture_default_str();
   cli.add_option("--th-n", o.min_size, "Th_n: min cluster size")->capture_default_str();
@@ -146,12 +151,18 @@ int main(int argc, char** argv) {
     if (!csv.empty()) io::WriteDirectionsCsv(csv, data);
     if (!plot.empty()) io::WriteImage(plot, direction::RenderTopView(prior, result));
     const auto& s = result.stats;
+    for (const auto& c : result.clusters) {
+      spdlog::info(
+          "direction prior {}: frames {}-{}, {} associations, std {:.2f} deg, headings "
+          "turn {:.2f} deg along the path",
+          c.id, c.first_frame, c.last_frame, c.size, c.std_deg, c.sweep_deg);
+    }
     spdlog::info(
         "{} VPs, {} pass the forward filter, {} first-level clusters ({} kept, {} after "
-        "Th_m/Th_l), {} direction priors ({} second-level clusters wider than Th_delta dropped), "
-        "{} associations ({} before V_interval {})",
+        "Th_m/Th_l), {} direction priors ({} second-level clusters wider than Th_delta and {} "
+        "turning with the road dropped), {} associations ({} before V_interval {})",
         s.input_vps, s.forward_kept, s.level1_clusters, s.level1_kept, s.window_kept,
-        s.level2_clusters, s.level2_too_wide, s.associations, s.associations_before_interval,
-        o.v_interval);
+        s.level2_clusters, s.level2_too_wide, s.level2_turning, s.associations,
+        s.associations_before_interval, o.v_interval);
   });
 }
