@@ -49,10 +49,10 @@ struct VisualMapOptions {
   // Observations are aligned to the point's reference patch (patch_align.h) before use.
   bool align_patches = true;
   // Observations whose patch does not align (NCC below align.min_ncc, or it drifts) are not
-  // added: they are most often a different surface point with a similar descriptor. Off by
-  // default: it thins the map where texture is poor (the demo's open road: 86 points on the
-  // sparsest keyframe) and the full chain then loses scale there (docs/visual_assoc.md).
-  bool require_alignment = false;
+  // added: they are most often a different surface point with a similar descriptor (repeated
+  // lane dashes, paving joints and window corners along the epipolar lines of a camera moving
+  // forward). docs/visual_assoc.md has the measurements behind the default.
+  bool require_alignment = true;
   vision::PatchAlignOptions align;
   int min_covisibility_weight = 15;  // Edges kept in the artifact (ORB-SLAM2 threshold).
   void Check() const;

@@ -1,6 +1,7 @@
 #include "vision/patch_align.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <cmath>
 
 namespace jvl::vision {
@@ -67,62 +68,97 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
   PatchAlignment out;
   if (!patch.valid) return out;
   constexpr int n = kPatchSize * kPatchSize;
+  // Target position of patch offset x: c + W x, W = scale * I at the start.
   Eigen::Vector2d c = start;
+  Eigen::Matrix2d w = scale * Eigen::Matrix2d::Identity();
   double a = 1, b = 0;
   std::array<float, n> current{};
-  for (int it = 0; it <= options.iterations; ++it) {
-    Eigen::Matrix4d h = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d g = Eigen::Vector4d::Zero();
-    int i = 0;
-    for (int dy = -kPatchRadius; dy <= kPatchRadius; ++dy) {
-      for (int dx = -kPatchRadius; dx <= kPatchRadius; ++dx, ++i) {
-        float v, gx, gy;
-        if (!Sample(level, c.x() + scale * dx, c.y() + scale * dy, &v, &gx, &gy)) return out;
-        current[i] = v;
-        const double t = patch.values[i];
-        const double r = v - a * t - b;
-        const Eigen::Vector4d j(gx, gy, -t, -1.0);
-        h += j * j.transpose();
-        g += j * r;
-      }
-    }
-    if (it == 0) {
-      // Start from the brightness change that matches means and spreads.
-      double mt = 0, mv = 0, st = 0, sv = 0;
-      for (int k = 0; k < n; ++k) mt += patch.values[k], mv += current[k];
-      mt /= n, mv /= n;
-      for (int k = 0; k < n; ++k) {
-        st += (patch.values[k] - mt) * (patch.values[k] - mt);
-        sv += (current[k] - mv) * (current[k] - mv);
-      }
-      if (st < 1e-6) return out;
-      a = std::sqrt(sv / st), b = mv - a * mt;
-      continue;
-    }
-    if (it == options.iterations) break;
-    Eigen::LDLT<Eigen::Matrix4d> ldlt(h);
-    if (ldlt.info() != Eigen::Success) return out;
-    const Eigen::Vector4d d = -ldlt.solve(g);
-    if (!d.allFinite()) return out;
-    c += d.head<2>();
-    a += d(2), b += d(3);
-    if ((c - start).norm() > options.max_shift) return out;
-    if (d.head<2>().squaredNorm() < 1e-6) {
-      // Converged: resample at the final position for the correlation.
-      int k = 0;
-      for (int yy = -kPatchRadius; yy <= kPatchRadius; ++yy) {
-        for (int xx = -kPatchRadius; xx <= kPatchRadius; ++xx, ++k) {
-          if (!Sample(level, c.x() + scale * xx, c.y() + scale * yy, &current[k], nullptr,
-                      nullptr)) {
-            return out;
-          }
+  // Stage 0: translation and brightness; stage 1 (options.affine): also the 2 x 2 warp.
+  const int stages = options.affine ? 2 : 1;
+  bool converged = false;
+  for (int stage = 0; stage < stages; ++stage) {
+    const int np = stage == 0 ? 4 : 8;
+    for (int it = 0; it <= options.iterations; ++it) {
+      Eigen::Matrix<double, 8, 8> h = Eigen::Matrix<double, 8, 8>::Zero();
+      Eigen::Matrix<double, 8, 1> g = Eigen::Matrix<double, 8, 1>::Zero();
+      int i = 0;
+      for (int dy = -kPatchRadius; dy <= kPatchRadius; ++dy) {
+        for (int dx = -kPatchRadius; dx <= kPatchRadius; ++dx, ++i) {
+          const Eigen::Vector2d q = c + w * Eigen::Vector2d(dx, dy);
+          float v, gx, gy;
+          if (!Sample(level, q.x(), q.y(), &v, &gx, &gy)) return out;
+          current[i] = v;
+          const double t = patch.values[i];
+          const double r = v - a * t - b;
+          Eigen::Matrix<double, 8, 1> j;
+          j << gx, gy, -t, -1.0, gx * dx, gx * dy, gy * dx, gy * dy;
+          h += j * j.transpose();
+          g += j * r;
         }
       }
-      break;
+      if (stage == 0 && it == 0) {
+        // Start from the brightness change that matches means and spreads.
+        double mt = 0, mv = 0, st = 0, sv = 0;
+        for (int k = 0; k < n; ++k) mt += patch.values[k], mv += current[k];
+        mt /= n, mv /= n;
+        for (int k = 0; k < n; ++k) {
+          st += (patch.values[k] - mt) * (patch.values[k] - mt);
+          sv += (current[k] - mv) * (current[k] - mv);
+        }
+        if (st < 1e-6) return out;
+        a = std::sqrt(sv / st), b = mv - a * mt;
+        continue;
+      }
+      if (it == options.iterations) break;
+      Eigen::VectorXd d;
+      if (np == 4) {
+        Eigen::LDLT<Eigen::Matrix4d> ldlt(h.topLeftCorner<4, 4>());
+        if (ldlt.info() != Eigen::Success) return out;
+        d = -ldlt.solve(g.head<4>());
+      } else {
+        // A weak pull of the warp towards its prediction keeps it defined on edge-like patches.
+        Eigen::Matrix<double, 8, 8> hr = h;
+        const double lambda = options.warp_prior * h.topLeftCorner<2, 2>().trace();
+        Eigen::Matrix<double, 8, 1> gr = g;
+        const Eigen::Matrix2d dw = w - scale * Eigen::Matrix2d::Identity();
+        const double prior[4] = {dw(0, 0), dw(0, 1), dw(1, 0), dw(1, 1)};
+        for (int k = 0; k < 4; ++k) hr(4 + k, 4 + k) += lambda, gr(4 + k) += lambda * prior[k];
+        Eigen::LDLT<Eigen::Matrix<double, 8, 8>> ldlt(hr);
+        if (ldlt.info() != Eigen::Success) return out;
+        d = -ldlt.solve(gr);
+      }
+      if (!d.allFinite()) return out;
+      c += d.head<2>();
+      a += d(2), b += d(3);
+      if (np == 8) {
+        w(0, 0) += d(4), w(0, 1) += d(5), w(1, 0) += d(6), w(1, 1) += d(7);
+        const double det = w.determinant() / (scale * scale);
+        if (!(det > 0.25 && det < 4) || (w / scale - Eigen::Matrix2d::Identity()).norm() > 1.0) {
+          return out;
+        }
+      }
+      if ((c - start).norm() > options.max_shift) return out;
+      // Converged when no patch sample moves by more than ~1e-3 level pixels.
+      const double move = d.head<2>().squaredNorm() +
+                          (np == 8 ? kPatchRadius * kPatchRadius * d.tail<4>().squaredNorm() : 0.0);
+      if (move < 1e-6) {
+        converged = true;
+        break;
+      }
+    }
+  }
+  (void)converged;
+  // Resample at the final position for the correlation.
+  int k = 0;
+  for (int yy = -kPatchRadius; yy <= kPatchRadius; ++yy) {
+    for (int xx = -kPatchRadius; xx <= kPatchRadius; ++xx, ++k) {
+      const Eigen::Vector2d q = c + w * Eigen::Vector2d(xx, yy);
+      if (!Sample(level, q.x(), q.y(), &current[k], nullptr, nullptr)) return out;
     }
   }
   out.ncc = Ncc(current.data(), patch.values.data(), n);
   out.level_xy = c;
+  out.warp = w;
   out.ok = out.ncc >= options.min_ncc;
   return out;
 }

@@ -32,13 +32,16 @@ PatchTemplate MakePatchTemplate(const cv::Mat& level, const Eigen::Vector2d& lev
 
 struct PatchAlignOptions {
   int iterations = 10;
-  double max_shift = 1.5;  // Level pixels from the start position.
-  double min_ncc = 0.8;    // Normalised cross-correlation required at the solution.
+  double max_shift = 1.5;    // Level pixels from the start position.
+  double min_ncc = 0.8;      // Normalised cross-correlation required at the solution.
+  bool affine = true;        // After the translation, also fit a 2 x 2 warp of the patch.
+  double warp_prior = 0.01;  // Weight of the warp's pull towards the predicted scale.
 };
 
 struct PatchAlignment {
   bool ok = false;
   Eigen::Vector2d level_xy = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d warp = Eigen::Matrix2d::Identity();  // Level pixels per patch pixel.
   double ncc = 0;
 };
 

@@ -109,10 +109,9 @@ TEST_F(SimMapCheckTest, SurfacePointsPassAndShiftedPointsFail) {
   EXPECT_LT(off.summary.all.within_threshold, 0.5);
 }
 
-// The figure of issue #8 on this short sequence. The issue asks for a median <= 5 cm; the map
-// built with the ground-truth prior and the default options measures 0.085 m here (0.074 m with
-// --require-alignment; docs/visual_assoc.md), so this bounds the current state against
-// regressions with a margin and checks the map is measurable at all.
+// The figure of issue #8 on this short sequence: with the ground-truth prior and the default
+// options the map's points lie within 5 cm of the true surface in the median for depth < 30 m
+// (0.0435 m and 55 % within 5 cm here; 0.042 m on the whole demo drive, docs/visual_assoc.md).
 TEST_F(SimMapCheckTest, GroundTruthPriorMapNearTheSurface) {
   RecordProperty("setup_seconds", std::to_string(setup_seconds_));
   const sim::SurfaceCheckOptions options;
@@ -124,8 +123,8 @@ TEST_F(SimMapCheckTest, GroundTruthPriorMapNearTheSurface) {
   EXPECT_EQ(r.max_keyframe_position_error_m, 0.0);
   EXPECT_GT(all.points, 1000);
   EXPECT_LT(all.no_hit, all.points / 100 + 1);
-  EXPECT_LE(all.median_perpendicular, 0.095);
-  EXPECT_GT(all.within_threshold, 0.30);
+  EXPECT_LE(all.median_perpendicular, 0.05);
+  EXPECT_GT(all.within_threshold, 0.50);
   ASSERT_EQ(r.summary.bins.size(), 3u);
   for (const auto& b : r.summary.bins) EXPECT_GT(b.points, 100);
   // Most points' observations agree with one true surface point (within 3 sigma).

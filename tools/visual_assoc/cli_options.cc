@@ -51,6 +51,11 @@ void AddVisualMapFlags(CLI::App& cli, mapping::VisualMapOptions* o) {
       ->capture_default_str()
       ->group("Method");
   add("--align-min-ncc", o->align.min_ncc, "Correlation required of an aligned patch");
+  cli.add_option("--align-affine", o->align.affine,
+                 "Fit a 2 x 2 warp of the patch as well (oblique surfaces)")
+      ->capture_default_str()
+      ->group("Method");
+  add("--align-warp-prior", o->align.warp_prior, "Pull of the warp towards the predicted scale");
   cli.add_option("--refine-on-insert", o->refine_on_insert,
                  "Refine points and drop outlier observations as keyframes are added")
       ->capture_default_str()
