@@ -44,12 +44,15 @@ void UpdateCentre(const std::vector<Candidate>& cands, Group* g) {
   g->std_deg = g->members.empty() ? 0 : std::sqrt(sq / g->members.size());
 }
 
-// How far the ground headings of a cluster's members turn along the path: the slope of the
-// least-squares line heading(s) (heading relative to the centre, s the travelled distance at the
-// member's frame) times the cluster's path length. 0 when the members do not spread along the
-// path.
-double HeadingSweepDeg(const std::vector<Candidate>& cands, const std::vector<double>& path,
-                       const GroundFrame& ground, const Group& g) {
+// How the ground headings of a cluster's members turn along the path: the least-squares line
+// heading(s) (heading relative to the centre, s the travelled distance at the member's frame).
+struct HeadingTurn {
+  double rate_deg_per_100m = 0;  // |slope|.
+  double sweep_deg = 0;          // |slope| times the cluster's path length.
+};
+HeadingTurn HeadingTurnAlongPath(const std::vector<Candidate>& cands,
+                                 const std::vector<double>& path, const GroundFrame& ground,
+                                 const Group& g) {
   const Eigen::Vector2d c = ground.Project(g.centre).normalized();
   double n = 0, ms = 0, mh = 0;
   std::vector<std::pair<double, double>> sh;
@@ -60,7 +63,8 @@ double HeadingSweepDeg(const std::vector<Candidate>& cands, const std::vector<do
     sh.push_back({s, h});
     n += 1, ms += s, mh += h;
   }
-  if (n < 2) return 0;
+  HeadingTurn out;
+  if (n < 2) return out;
   ms /= n, mh /= n;
   double sss = 0, ssh = 0, lo = sh.front().first, hi = lo;
   for (const auto& [s, h] : sh) {
@@ -68,7 +72,19 @@ double HeadingSweepDeg(const std::vector<Candidate>& cands, const std::vector<do
     ssh += (s - ms) * (h - mh);
     lo = std::min(lo, s), hi = std::max(hi, s);
   }
-  return sss > 1e-12 ? std::abs(ssh / sss) * (hi - lo) : 0.0;
+  if (sss <= 1e-12) return out;
+  const double slope = std::abs(ssh / sss);
+  out.rate_deg_per_100m = 100 * slope;
+  out.sweep_deg = slope * (hi - lo);
+  return out;
+}
+
+// A bend: the headings turn by more than max_sweep_deg, at more than max_turn_rate. The rate
+// tells a bend (tens of degrees per 100 m) from the prior's own yaw drift on a long straight
+// (below 1 deg per 100 m for the lidar-n1 preset), which adds up over a kilometre but is what
+// the direction prior is there to correct.
+bool IsBend(const HeadingTurn& t, const DirectionClusterOptions& o) {
+  return t.sweep_deg > o.max_sweep_deg && t.rate_deg_per_100m > o.max_turn_rate_deg_per_100m;
 }
 
 // Step 1 and Alg. 2 lines 2-8: world directions and the forward filter.
@@ -269,6 +285,7 @@ void DirectionClusterOptions::Check() const {
   JVL_CHECK(slope_subset_deg >= 0, "direction: slope subset width must be >= 0 deg");
   JVL_CHECK(max_std_deg > 0, "direction: max std (Th_delta) must be > 0 deg");
   JVL_CHECK(max_sweep_deg > 0, "direction: max sweep must be > 0 deg");
+  JVL_CHECK(max_turn_rate_deg_per_100m >= 0, "direction: max turn rate must be >= 0 deg/100 m");
   JVL_CHECK(min_size >= 1, "direction: min size (Th_n) must be >= 1");
   JVL_CHECK(clusters_per_window >= 1, "direction: clusters per window (Th_m) must be >= 1");
   JVL_CHECK(window_length_m > 0, "direction: window length (Th_l) must be > 0 m");
@@ -326,8 +343,8 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
   const size_t before_sweep = groups.size();
   groups.erase(std::remove_if(groups.begin(), groups.end(),
                               [&](const Group& g) {
-                                return HeadingSweepDeg(cands, path, ground, g) >
-                                       options.max_sweep_deg;
+                                return IsBend(HeadingTurnAlongPath(cands, path, ground, g),
+                                              options);
                               }),
                groups.end());
   st.level2_turning = int(before_sweep - groups.size());
@@ -350,7 +367,9 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
     info.members = int(g.members.size());
     info.level1 = g.level1;
     info.slope_deg = SlopeDeg(ground, g.centre);
-    info.sweep_deg = HeadingSweepDeg(cands, path, ground, g);
+    const HeadingTurn turn = HeadingTurnAlongPath(cands, path, ground, g);
+    info.sweep_deg = turn.sweep_deg;
+    info.turn_rate_deg_per_100m = turn.rate_deg_per_100m;
     result.clusters.push_back(info);
     for (int m : g.members) {
       const VpObservation& vp = vps[cands[m].vp];

@@ -55,9 +55,11 @@ struct DirectionClusterOptions {
   // Clusters whose centre slopes (ground heading mod 180 deg) are within this form one subset.
   double slope_subset_deg = 5.0;
   double max_std_deg = 1.5;  // Th_delta: max RMS angle of the members to the centre.
-  // A final cluster whose members' ground headings turn steadily along the path by more than
-  // this (deg, least-squares line over the cluster's path length) is a bend, not a direction.
+  // A final cluster whose members' ground headings turn steadily along the path (least-squares
+  // line over the travelled distance) by more than max_sweep_deg over its length, at more than
+  // max_turn_rate_deg_per_100m, is a bend, not a direction.
   double max_sweep_deg = 2.5;
+  double max_turn_rate_deg_per_100m = 3.0;
   int min_size = 10;            // Th_n: min members of a kept cluster (also after each later step).
   int clusters_per_window = 1;  // Th_m: clusters kept per window of travelled distance.
   double window_length_m = 20.0;  // Th_l: window length (m of travelled path).
@@ -81,6 +83,7 @@ struct DirectionClusterInfo {
   int level1 = 0;        // First-level cluster it came from (diagnostic).
   double slope_deg = 0;  // Ground heading of `direction` mod 180 deg.
   double sweep_deg = 0;  // Turn of the members' headings along the path (max_sweep_deg).
+  double turn_rate_deg_per_100m = 0;  // ... per 100 m of path (max_turn_rate_deg_per_100m).
 };
 
 struct DirectionAssociation {

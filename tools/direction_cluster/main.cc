@@ -105,8 +105,12 @@ int main(int argc, char** argv) {
   cli.add_option("--slope-subset", o.slope_subset_deg, "Slope gap (deg) that separates subsets")
       ->capture_default_str();
   cli.add_option("--max-sweep", o.max_sweep_deg,
-                 "Max turn of a direction prior's VP headings along its path (deg; larger: a "
-                 "bend)")
+                 "A direction prior whose VP headings turn by more than this along its path (deg) "
+                 "at more than --max-turn-rate is a bend and dropped")
+      ->capture_default_str();
+  cli.add_option("--max-turn-rate", o.max_turn_rate_deg_per_100m,
+                 "Turn rate (deg/100 m) above which a turning direction prior is a bend; the "
+                 "prior's own yaw drift turns far slower")
       ->capture_default_str();
   cli.add_option("--th-delta", o.max_std_deg, "Th_delta: max cluster std (deg)")
       ->capture_default_str();
@@ -154,8 +158,9 @@ int main(int argc, char** argv) {
     for (const auto& c : result.clusters) {
       spdlog::info(
           "direction prior {}: frames {}-{}, {} associations, std {:.2f} deg, headings "
-          "turn {:.2f} deg along the path",
-          c.id, c.first_frame, c.last_frame, c.size, c.std_deg, c.sweep_deg);
+          "turn {:.2f} deg along the path ({:.2f} deg/100 m)",
+          c.id, c.first_frame, c.last_frame, c.size, c.std_deg, c.sweep_deg,
+          c.turn_rate_deg_per_100m);
     }
     spdlog::info(
         "{} VPs, {} pass the forward filter, {} first-level clusters ({} kept, {} after "
