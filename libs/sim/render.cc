@@ -30,14 +30,19 @@ double ExposureGain(int64_t frame, double variation, uint64_t seed) {
 
 namespace {
 
-// Radiance (grey level 0..255 before gain) along one ray.
+// Radiance (grey level 0..255 before gain) along one ray through a pixel that subtends
+// pixel_angle (rad).
 double ShadeRay(const Scene& scene, const Hit& hit, const Eigen::Vector3d& o,
-                const Eigen::Vector3d& d, const Eigen::Vector3d& sun, const CameraOptions& opt) {
+                const Eigen::Vector3d& d, const Eigen::Vector3d& sun, double pixel_angle,
+                const CameraOptions& opt) {
   // Sky: brighter towards the horizon.
   const double sky = 255.0 * (0.93 - 0.12 * std::clamp(d.z(), 0.0, 1.0));
   if (!hit.valid()) return sky;
   const Eigen::Vector3d p = o + hit.t * d;
-  const Surface s = ShadeSurface(scene, hit, p);
+  // The pixel's footprint on the surface: t * pixel_angle across the ray, stretched by
+  // 1 / cos(incidence) along it; the side of a square of the same area.
+  const double incidence = std::max(std::abs(hit.normal.dot(d)), 1e-3);
+  const Surface s = ShadeSurface(scene, hit, p, hit.t * pixel_angle / std::sqrt(incidence));
   const double light = 0.5 + 0.55 * std::max(0.0, hit.normal.dot(sun));
   const double value = 255.0 * s.albedo * light;
   if (hit.t <= opt.haze_start) return value;
@@ -54,76 +59,115 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
   const Eigen::Matrix3d R = world_from_cam.RotationMatrix();
   const Eigen::Vector3d o = world_from_cam.translation();
   const Eigen::Vector3d sun = options.sun_direction.normalized();
+  const double pixel_angle = 1.0 / camera.fx;
   std::vector<Box> near;
   for (const Box& b : moving) {
     if (b.size.x() > 0 && (b.center - o).norm() < 200) near.push_back(b);
   }
   // Pass 1: one ray through every pixel centre.
-  cv::Mat radiance(camera.height, camera.width, CV_32F);
-  cv::Mat surface(camera.height, camera.width, CV_32S);  // What the centre ray hits.
+  const int w = camera.width, h = camera.height;
+  cv::Mat radiance(h, w, CV_32F);
+  cv::Mat surface(h, w, CV_32S);  // What the centre ray hits: face, -2 - moving box, -1 sky.
+  std::vector<Hit> centre_hits(static_cast<size_t>(w) * static_cast<size_t>(h));
   Eigen::Vector3d dirs[8];
   Hit hits[8];
-  for (int j = 0; j < camera.height; ++j) {
+  for (int j = 0; j < h; ++j) {
     float* row = radiance.ptr<float>(j);
     int32_t* id = surface.ptr<int32_t>(j);
-    for (int i0 = 0; i0 < camera.width; i0 += 8) {
-      const int n = std::min(8, camera.width - i0);
+    for (int i0 = 0; i0 < w; i0 += 8) {
+      const int n = std::min(8, w - i0);
       for (int k = 0; k < n; ++k) {
         dirs[k] = (R * camera.Unproject(Eigen::Vector2d(i0 + k, j))).normalized();
       }
       caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
       for (int k = 0; k < n; ++k) {
         IntersectBoxes(near, o, dirs[k], &hits[k]);
-        row[i0 + k] = static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, options));
+        row[i0 + k] = static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, pixel_angle, options));
         id[i0 + k] = hits[k].dynamic >= 0 ? -2 - hits[k].dynamic : hits[k].face;
+        centre_hits[static_cast<size_t>(j) * w + i0 + k] = hits[k];
       }
     }
   }
   const int ss = options.supersample;
   if (ss > 1) {
-    // Pass 2: a pixel whose 3 x 3 neighbourhood sees another surface or differs by more than
-    // supersample_contrast grey levels is replaced by the mean of ss x ss rays spread over its
-    // area (the pixel integrates the light falling on it); elsewhere the centre ray stands for
-    // the pixel.
+    // Pass 2: a pixel whose 3 x 3 neighbourhood sees another surface, or whose centre-ray
+    // radiance is not locally linear (a second difference along a row, column or diagonal above
+    // supersample_contrast grey levels: a texture edge, not a smooth shading gradient), is
+    // replaced by the mean of ss x ss rays spread over its area (the pixel integrates the light
+    // falling on it). Elsewhere the centre ray is the pixel's mean. Where the whole neighbourhood
+    // sees one surface, only its texture changes within the pixel: the sub-pixel rays meet the
+    // plane of the centre ray's hit (the surfaces are planar at the scale of a pixel) and are
+    // shaded there, without a ray cast.
     const cv::Mat centre = radiance.clone();
     const float contrast = static_cast<float>(options.supersample_contrast);
     const float weight = 1.0f / static_cast<float>(ss * ss);
-    std::vector<int> columns;
+    // Sub-pixel offsets on a rotated grid: the ss x ss lattice turned by atan(1 / ss) puts every
+    // sample at its own column and row of an ss^2 x ss^2 sub-grid, so a near-vertical or
+    // near-horizontal edge (the common case) moves the pixel's mean in ss^2 steps instead of ss
+    // (for ss = 2 the rotated-grid pattern of graphics hardware). With an odd ss the middle
+    // sample is the centre ray, whose value is reused.
     std::vector<Eigen::Vector2d> offsets;
+    const double cells = static_cast<double>(ss * ss);
     for (int sy = 0; sy < ss; ++sy) {
       for (int sx = 0; sx < ss; ++sx) {
-        offsets.emplace_back((sx + 0.5) / ss - 0.5, (sy + 0.5) / ss - 0.5);
+        if (ss % 2 == 1 && 2 * sx + 1 == ss && 2 * sy + 1 == ss) continue;
+        offsets.emplace_back((ss * sx + sy + 0.5) / cells - 0.5,
+                             (ss * sy - sx + ss - 1 + 0.5) / cells - 0.5);
       }
     }
-    for (int j = 0; j < camera.height; ++j) {
-      columns.clear();
-      for (int i = 0; i < camera.width; ++i) {
+    const int rays = static_cast<int>(offsets.size());
+    const float centre_weight = ss % 2 == 1 ? weight : 0.0f;
+    std::vector<int> cast;  // Pixels of the row whose sub-pixel rays are cast.
+    for (int j = 0; j < h; ++j) {
+      cast.clear();
+      float* row = radiance.ptr<float>(j);
+      for (int i = 0; i < w; ++i) {
         const float c = centre.at<float>(j, i);
         const int32_t f = surface.at<int32_t>(j, i);
-        bool refine = false;
-        for (int y = std::max(0, j - 1); y <= std::min(camera.height - 1, j + 1) && !refine; ++y) {
-          const float* cr = centre.ptr<float>(y);
+        bool other_surface = false;
+        for (int y = std::max(0, j - 1); y <= std::min(h - 1, j + 1); ++y) {
           const int32_t* sr = surface.ptr<int32_t>(y);
-          for (int x = std::max(0, i - 1); x <= std::min(camera.width - 1, i + 1); ++x) {
-            if (sr[x] != f || std::abs(cr[x] - c) > contrast) {
-              refine = true;
-              break;
-            }
+          for (int x = std::max(0, i - 1); x <= std::min(w - 1, i + 1); ++x) {
+            other_surface = other_surface || sr[x] != f;
           }
         }
-        if (refine) columns.push_back(i);
+        // Second differences (borders replicate the edge pixel).
+        const int up = std::max(0, j - 1), down = std::min(h - 1, j + 1);
+        const int left = std::max(0, i - 1), right = std::min(w - 1, i + 1);
+        const float* ru = centre.ptr<float>(up);
+        const float* rc = centre.ptr<float>(j);
+        const float* rd = centre.ptr<float>(down);
+        const float curvature = std::max(
+            std::max(std::abs(rc[left] + rc[right] - 2 * c), std::abs(ru[i] + rd[i] - 2 * c)),
+            std::max(std::abs(ru[left] + rd[right] - 2 * c), std::abs(ru[right] + rd[left] - 2 * c)));
+        const bool edge = curvature > contrast;
+        if (other_surface || (edge && f < 0)) {
+          cast.push_back(i);
+        } else if (edge) {
+          const Hit& hc = centre_hits[static_cast<size_t>(j) * w + i];
+          const Eigen::Vector3d dc = (R * camera.Unproject(Eigen::Vector2d(i, j))).normalized();
+          const double plane = hc.normal.dot(dc) * hc.t;  // n . (p - o) for the hit p.
+          float sum = centre_weight * c;
+          for (const Eigen::Vector2d& d : offsets) {
+            Hit sub = hc;
+            const Eigen::Vector3d ds =
+                (R * camera.Unproject(Eigen::Vector2d(i + d.x(), j + d.y()))).normalized();
+            sub.t = plane / hc.normal.dot(ds);
+            sum += weight * static_cast<float>(ShadeRay(scene, sub, o, ds, sun, pixel_angle, options));
+          }
+          row[i] = sum;
+        }
       }
-      // Sub-pixel rays of the marked pixels, eight at a time.
-      float* row = radiance.ptr<float>(j);
-      for (int i : columns) row[i] = 0;
-      const int64_t total = static_cast<int64_t>(columns.size()) * ss * ss;
+      // Sub-pixel rays of the pixels at a surface boundary, eight at a time.
+      for (int i : cast) row[i] = centre_weight * centre.at<float>(j, i);
+      const int64_t total = static_cast<int64_t>(cast.size()) * rays;
       int pixel[8];
       for (int64_t r0 = 0; r0 < total; r0 += 8) {
         const int n = static_cast<int>(std::min<int64_t>(8, total - r0));
         for (int k = 0; k < n; ++k) {
           const int64_t r = r0 + k;
-          pixel[k] = columns[static_cast<size_t>(r / (ss * ss))];
-          const Eigen::Vector2d& d = offsets[static_cast<size_t>(r % (ss * ss))];
+          pixel[k] = cast[static_cast<size_t>(r / rays)];
+          const Eigen::Vector2d& d = offsets[static_cast<size_t>(r % rays)];
           dirs[k] =
               (R * camera.Unproject(Eigen::Vector2d(pixel[k] + d.x(), j + d.y()))).normalized();
         }
@@ -131,7 +175,7 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
         for (int k = 0; k < n; ++k) {
           IntersectBoxes(near, o, dirs[k], &hits[k]);
           row[pixel[k]] +=
-              weight * static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, options));
+              weight * static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, pixel_angle, options));
         }
       }
     }

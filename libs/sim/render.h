@@ -17,10 +17,11 @@ struct CameraOptions {
   double pixel_noise = 2.0;          // Standard deviation in grey levels.
   double exposure_variation = 0.12;  // Relative amplitude of the frame-to-frame gain change.
   double blur_sigma = 0.6;           // Pixels (lens / demosaicing softness).
-  // Area integration: pixels at a surface boundary or with more than supersample_contrast grey
-  // levels between neighbouring centre rays average supersample x supersample rays.
-  int supersample = 3;
-  double supersample_contrast = 4.0;
+  // Area integration: pixels at a surface boundary or where the centre-ray radiance bends by more
+  // than supersample_contrast grey levels (second difference of neighbouring centre rays: a
+  // texture edge) average supersample x supersample rays.
+  int supersample = 2;
+  double supersample_contrast = 8.0;
   double max_range = 400.0;                         // Beyond: sky.
   double haze_start = 90.0;                         // Distance haze begins (m).
   Eigen::Vector3d sun_direction{0.45, 0.35, 0.82};  // Map frame, towards the sun.

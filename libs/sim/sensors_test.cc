@@ -159,14 +159,61 @@ TEST(RenderTest, SupersamplingEncodesTheSubPixelEdgePosition) {
     }
     return (img.cols - 0.5) - covered;
   };
-  double worst_point = 0, worst_area = 0;
-  for (double u = 600.0; u < 601.0; u += 0.125) {
+  double worst_point = 0, worst_2 = 0, worst_3 = 0;
+  for (double u = 600.0; u < 601.0; u += 0.0625) {
     worst_point = std::max(worst_point, std::abs(edge(u, 1) - u));
-    worst_area = std::max(worst_area, std::abs(edge(u, 3) - u));
+    worst_2 = std::max(worst_2, std::abs(edge(u, 2) - u));
+    worst_3 = std::max(worst_3, std::abs(edge(u, 3) - u));
   }
-  // 3 x 3 rays: the covered fraction in steps of 1/3, so within 1/6 px (+ grey rounding).
-  EXPECT_LT(worst_area, 0.2);
+  // The rotated grid puts the ss x ss rays in ss^2 different columns: the covered fraction of a
+  // vertical edge comes in steps of 1 / ss^2, so the edge is found within 1 / (2 ss^2) px (plus
+  // grey-level rounding); a plain 2 x 2 grid would be off by up to 1/4 px.
+  EXPECT_LT(worst_2, 0.14);
+  EXPECT_LT(worst_3, 0.07);
   EXPECT_GT(worst_point, 0.4);  // One ray: anywhere within the pixel.
+  std::printf("edge position error: 1 ray %.3f px, 2 x 2 %.3f px, 3 x 3 %.3f px\n", worst_point,
+              worst_2, worst_3);
+}
+
+// Texture noise finer than the sensor's footprint averages out within one sample (as a pixel
+// integrates it): the fine octaves fade, the coarse ones stay, the mean stays.
+TEST(ShadingTest, NoiseFinerThanTheFootprintAveragesOut) {
+  const auto world = SmallWorld(0.0, 0.0);
+  const Scene& scene = world->scene;
+  Hit hit;
+  for (size_t i = 0; i < scene.mesh.faces.size() && hit.face < 0; ++i) {
+    if (scene.mesh.faces[i].material == Material::kGround) hit.face = static_cast<int32_t>(i);
+  }
+  ASSERT_GE(hit.face, 0);
+  // Grass beside the road: 200 points 1 cm apart along it, 12 m to the left of the centre line.
+  const RoadPoint r = scene.route.At(20.0);
+  const Eigen::Vector2d along(std::cos(r.heading), std::sin(r.heading));
+  const Eigen::Vector2d left(-along.y(), along.x());
+  const auto albedo = [&](int k, double footprint) {
+    const Eigen::Vector2d q = r.position + 12.0 * left + 0.01 * k * along;
+    return static_cast<double>(ShadeSurface(scene, hit, {q.x(), q.y(), 0.0}, footprint).albedo);
+  };
+  // Mean absolute step between neighbours (fine detail) and the spread of the values.
+  const auto stats = [&](double footprint, double* step, double* spread) {
+    double lo = 1, hi = 0;
+    *step = 0;
+    for (int k = 0; k < 200; ++k) {
+      const double a = albedo(k, footprint);
+      lo = std::min(lo, a);
+      hi = std::max(hi, a);
+      if (k > 0) *step += std::abs(a - albedo(k - 1, footprint)) / 199;
+    }
+    *spread = hi - lo;
+  };
+  double step_point, spread_point, step_pixel, spread_pixel, step_far, spread_far;
+  stats(0.0, &step_point, &spread_point);   // A point sample: every octave.
+  stats(0.1, &step_pixel, &spread_pixel);   // 10 cm footprint: the 7 / m octave is gone.
+  stats(10.0, &step_far, &spread_far);      // Every octave is finer than the footprint.
+  EXPECT_GT(spread_point, 0.01);
+  EXPECT_LT(step_pixel, 0.5 * step_point);
+  EXPECT_GT(spread_pixel, 0.0);
+  EXPECT_EQ(spread_far, 0.0);
+  EXPECT_NEAR(albedo(0, 10.0), 0.32, 1e-6);  // The grass albedo without noise: the mean.
 }
 
 TEST(RenderTest, FeaturesLandOnStructure) {

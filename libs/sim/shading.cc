@@ -10,15 +10,25 @@ namespace {
 
 double Fract(double x) { return x - std::floor(x); }
 
+// Value noise of the given frequency (1/m) minus its mean 0.5, faded out where its cells (1 /
+// frequency) span less than four footprints and gone below two: finer detail averages out
+// within one sample.
+double Octave(double x, double y, double frequency, uint64_t seed, double footprint) {
+  const double cells = 1.0 / (frequency * std::max(footprint, 1e-9));  // Footprints per cell.
+  const double fade = std::clamp(0.5 * cells - 1.0, 0.0, 1.0);
+  if (fade == 0.0) return 0.0;
+  return fade * (ValueNoise(x * frequency, y * frequency, seed) - 0.5);
+}
+
 // Road surface in route coordinates (s along, lat to the left of the centre line).
-Surface ShadeGround(const Scene& scene, const Eigen::Vector3d& p) {
+Surface ShadeGround(const Scene& scene, const Eigen::Vector3d& p, double footprint) {
   const uint64_t seed = scene.options.seed;
   Surface out;
   double s = 0, lat = 0;
   scene.route.Project(p.head<2>(), &s, &lat);
   const double hw = scene.options.road_half_width, a = std::abs(lat);
-  const double fine = ValueNoise(p.x() * 7, p.y() * 7, seed + 1) - 0.5;
-  const double coarse = ValueNoise(p.x() * 0.6, p.y() * 0.6, seed + 2) - 0.5;
+  const double fine = Octave(p.x(), p.y(), 7, seed + 1, footprint);
+  const double coarse = Octave(p.x(), p.y(), 0.6, seed + 2, footprint);
   if (a <= hw) {
     out.albedo = static_cast<float>(0.22 + 0.07 * coarse + 0.05 * fine);
     out.reflectance = 0.12f;
@@ -46,7 +56,7 @@ Surface ShadeGround(const Scene& scene, const Eigen::Vector3d& p) {
     out.reflectance = 0.25f;
   } else {
     out.albedo = static_cast<float>(0.32 + 0.14 * coarse + 0.08 * fine +
-                                    0.06 * (ValueNoise(p.x() * 2, p.y() * 2, seed + 4) - 0.5));
+                                    0.06 * Octave(p.x(), p.y(), 2, seed + 4, footprint));
     out.reflectance = 0.2f;
   }
   return out;
@@ -54,15 +64,16 @@ Surface ShadeGround(const Scene& scene, const Eigen::Vector3d& p) {
 
 // Facade: floors with a ledge, a window grid with bright frames and dark glass, shop windows
 // on the ground floor (Sec. 4.3 relies on such lines parallel to the road and vertical).
-Surface ShadeFacade(const Scene& scene, const Face& f, const Eigen::Vector3d& p) {
+Surface ShadeFacade(const Scene& scene, const Face& f, const Eigen::Vector3d& p,
+                    double footprint) {
   const Building& b = scene.buildings[f.object];
   const Eigen::Vector3f q = p.cast<float>() - f.origin;
   const double u = q.dot(f.u), v = q.dot(f.v);
   const uint64_t seed = scene.options.seed + static_cast<uint64_t>(f.object) * 7919;
   Surface out;
   out.reflectance = 0.3f;
-  double albedo = b.albedo * (0.93 + 0.12 * (ValueNoise(u * 1.3, v * 1.3, seed) - 0.5) +
-                              0.08 * (ValueNoise(u * 9, v * 9, seed + 1) - 0.5));
+  double albedo = b.albedo * (0.93 + 0.12 * Octave(u, v, 1.3, seed, footprint) +
+                              0.08 * Octave(u, v, 9, seed + 1, footprint));
   const int floor = static_cast<int>(std::floor(v / b.floor_height));
   const double fv = v - floor * b.floor_height;
   const double margin = 1.2;
@@ -97,7 +108,8 @@ Surface ShadeFacade(const Scene& scene, const Face& f, const Eigen::Vector3d& p)
 
 }  // namespace
 
-Surface ShadeSurface(const Scene& scene, const Hit& hit, const Eigen::Vector3d& p) {
+Surface ShadeSurface(const Scene& scene, const Hit& hit, const Eigen::Vector3d& p,
+                     double footprint) {
   Surface out;
   if (hit.dynamic >= 0) {
     out.albedo = static_cast<float>(0.15 + 0.2 * (hit.dynamic % 3));
@@ -106,12 +118,14 @@ Surface ShadeSurface(const Scene& scene, const Hit& hit, const Eigen::Vector3d& 
   }
   if (hit.face < 0) return out;
   const Face& f = scene.mesh.faces[hit.face];
-  auto noise = [&] { return ValueNoise(p.x() * 4, p.y() * 4 + p.z() * 4, scene.options.seed + 9); };
+  auto noise = [&] {
+    return 0.5 + Octave(p.x(), p.y() + p.z(), 4, scene.options.seed + 9, footprint);
+  };
   switch (f.material) {
     case Material::kGround:
-      return ShadeGround(scene, p);
+      return ShadeGround(scene, p, footprint);
     case Material::kFacade:
-      return ShadeFacade(scene, f, p);
+      return ShadeFacade(scene, f, p, footprint);
     case Material::kRoof:
       out.albedo = 0.35f;
       out.reflectance = 0.25f;

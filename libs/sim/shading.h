@@ -16,7 +16,10 @@ struct Surface {
   bool marking = false;      // Lane marking / crossing stripe on the road.
 };
 
-// Appearance of the surface hit at world point p.
-Surface ShadeSurface(const Scene& scene, const Hit& hit, const Eigen::Vector3d& p);
+// Appearance of the surface hit at world point p. footprint (m) is the size of the sensor's
+// sample on the surface (0: a point): noise textures finer than about two footprints average out
+// within the sample and fade to their mean (band-limited textures, as a pixel integrates them).
+Surface ShadeSurface(const Scene& scene, const Hit& hit, const Eigen::Vector3d& p,
+                     double footprint = 0.0);
 
 }  // namespace jvl::sim

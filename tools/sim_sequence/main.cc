@@ -43,11 +43,13 @@ int main(int argc, char** argv) {
   cli.add_option("--pixel-noise", opt.camera.pixel_noise, "Image noise sigma (grey levels)")
       ->capture_default_str();
   cli.add_option("--supersample", opt.camera.supersample,
-                 "Camera rays per pixel along each axis (the pixel area is averaged)")
+                 "Camera rays per pixel along each axis, on a rotated grid, where the pixel "
+                 "sees an edge (its area is averaged); 1: one ray per pixel centre")
       ->capture_default_str();
   cli.add_option("--supersample-contrast", opt.camera.supersample_contrast,
-                 "Grey levels between neighbouring pixel centres above which a pixel is "
-                 "supersampled (negative: every pixel)")
+                 "A pixel is supersampled where its neighbourhood sees another surface or the "
+                 "second difference of neighbouring centre rays exceeds this many grey levels "
+                 "(negative: every pixel)")
       ->capture_default_str();
   cli.add_option("--exposure-variation", opt.camera.exposure_variation,
                  "Relative frame-to-frame exposure change")
