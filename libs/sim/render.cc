@@ -50,6 +50,41 @@ double ShadeRay(const Scene& scene, const Hit& hit, const Eigen::Vector3d& o,
   return value + w * (sky - value);
 }
 
+// A pixel whose neighbourhood sees one surface: its sub-pixel rays (offsets from the pixel
+// (i, j)) meet the plane of the centre ray's hit, planar at the scale of a pixel, and are shaded
+// there without a ray cast. *value = base + weight x the sum of their radiances. Returns false,
+// *value untouched, when a ray runs (nearly) parallel to the plane or meets it behind the
+// camera or beyond max_range, or when there are more than 16 (supersample > 4): the caller
+// casts the rays then.
+bool ShadeOnPlane(const Scene& scene, const Hit& centre, const Eigen::Vector3d& o,
+                  const Eigen::Matrix3d& R, const PinholeCamera& camera, int i, int j,
+                  const std::vector<Eigen::Vector2d>& offsets, const Eigen::Vector3d& sun,
+                  double pixel_angle, const CameraOptions& options, float base, float weight,
+                  float* value) {
+  const Eigen::Vector3d dc = (R * camera.Unproject(Eigen::Vector2d(i, j))).normalized();
+  const double plane = centre.normal.dot(dc) * centre.t;  // n . (p - o) for the hit p (< 0).
+  Eigen::Vector3d dirs[16];
+  double ts[16];
+  const size_t n = std::min<size_t>(offsets.size(), 16);
+  for (size_t k = 0; k < n; ++k) {
+    dirs[k] = (R * camera.Unproject(Eigen::Vector2d(i + offsets[k].x(), j + offsets[k].y())))
+                  .normalized();
+    const double cos_n = centre.normal.dot(dirs[k]);
+    if (cos_n > -1e-6) return false;
+    ts[k] = plane / cos_n;
+    if (!(ts[k] > 0.0 && ts[k] <= options.max_range)) return false;
+  }
+  if (n < offsets.size()) return false;
+  float sum = base;
+  for (size_t k = 0; k < n; ++k) {
+    Hit sub = centre;
+    sub.t = ts[k];
+    sum += weight * static_cast<float>(ShadeRay(scene, sub, o, dirs[k], sun, pixel_angle, options));
+  }
+  *value = sum;
+  return true;
+}
+
 }  // namespace
 
 cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCamera& camera,
@@ -82,7 +117,8 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
       caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
       for (int k = 0; k < n; ++k) {
         IntersectBoxes(near, o, dirs[k], &hits[k]);
-        row[i0 + k] = static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, pixel_angle, options));
+        row[i0 + k] =
+            static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, pixel_angle, options));
         id[i0 + k] = hits[k].dynamic >= 0 ? -2 - hits[k].dynamic : hits[k].face;
         centre_hits[static_cast<size_t>(j) * w + i0 + k] = hits[k];
       }
@@ -139,23 +175,15 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
         const float* rd = centre.ptr<float>(down);
         const float curvature = std::max(
             std::max(std::abs(rc[left] + rc[right] - 2 * c), std::abs(ru[i] + rd[i] - 2 * c)),
-            std::max(std::abs(ru[left] + rd[right] - 2 * c), std::abs(ru[right] + rd[left] - 2 * c)));
+            std::max(std::abs(ru[left] + rd[right] - 2 * c),
+                     std::abs(ru[right] + rd[left] - 2 * c)));
         const bool edge = curvature > contrast;
         if (other_surface || (edge && f < 0)) {
           cast.push_back(i);
-        } else if (edge) {
-          const Hit& hc = centre_hits[static_cast<size_t>(j) * w + i];
-          const Eigen::Vector3d dc = (R * camera.Unproject(Eigen::Vector2d(i, j))).normalized();
-          const double plane = hc.normal.dot(dc) * hc.t;  // n . (p - o) for the hit p.
-          float sum = centre_weight * c;
-          for (const Eigen::Vector2d& d : offsets) {
-            Hit sub = hc;
-            const Eigen::Vector3d ds =
-                (R * camera.Unproject(Eigen::Vector2d(i + d.x(), j + d.y()))).normalized();
-            sub.t = plane / hc.normal.dot(ds);
-            sum += weight * static_cast<float>(ShadeRay(scene, sub, o, ds, sun, pixel_angle, options));
-          }
-          row[i] = sum;
+        } else if (edge && !ShadeOnPlane(scene, centre_hits[static_cast<size_t>(j) * w + i], o, R,
+                                         camera, i, j, offsets, sun, pixel_angle, options,
+                                         centre_weight * c, weight, &row[i])) {
+          cast.push_back(i);  // A sub-pixel ray misses the plane (grazing view): cast them all.
         }
       }
       // Sub-pixel rays of the pixels at a surface boundary, eight at a time.
@@ -174,8 +202,8 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
         caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
         for (int k = 0; k < n; ++k) {
           IntersectBoxes(near, o, dirs[k], &hits[k]);
-          row[pixel[k]] +=
-              weight * static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, pixel_angle, options));
+          row[pixel[k]] += weight * static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun,
+                                                                pixel_angle, options));
         }
       }
     }

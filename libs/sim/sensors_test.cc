@@ -206,9 +206,9 @@ TEST(ShadingTest, NoiseFinerThanTheFootprintAveragesOut) {
     *spread = hi - lo;
   };
   double step_point, spread_point, step_pixel, spread_pixel, step_far, spread_far;
-  stats(0.0, &step_point, &spread_point);   // A point sample: every octave.
-  stats(0.1, &step_pixel, &spread_pixel);   // 10 cm footprint: the 7 / m octave is gone.
-  stats(10.0, &step_far, &spread_far);      // Every octave is finer than the footprint.
+  stats(0.0, &step_point, &spread_point);  // A point sample: every octave.
+  stats(0.1, &step_pixel, &spread_pixel);  // 10 cm footprint: the 7 / m octave is gone.
+  stats(10.0, &step_far, &spread_far);     // Every octave is finer than the footprint.
   EXPECT_GT(spread_point, 0.01);
   EXPECT_LT(step_pixel, 0.5 * step_point);
   EXPECT_GT(spread_pixel, 0.0);

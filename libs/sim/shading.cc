@@ -64,8 +64,7 @@ Surface ShadeGround(const Scene& scene, const Eigen::Vector3d& p, double footpri
 
 // Facade: floors with a ledge, a window grid with bright frames and dark glass, shop windows
 // on the ground floor (Sec. 4.3 relies on such lines parallel to the road and vertical).
-Surface ShadeFacade(const Scene& scene, const Face& f, const Eigen::Vector3d& p,
-                    double footprint) {
+Surface ShadeFacade(const Scene& scene, const Face& f, const Eigen::Vector3d& p, double footprint) {
   const Building& b = scene.buildings[f.object];
   const Eigen::Vector3f q = p.cast<float>() - f.origin;
   const double u = q.dot(f.u), v = q.dot(f.v);

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   cli.add_option("--supersample", opt.camera.supersample,
                  "Camera rays per pixel along each axis, on a rotated grid, where the pixel "
                  "sees an edge (its area is averaged); 1: one ray per pixel centre")
+      ->check(CLI::Range(1, 8))
       ->capture_default_str();
   cli.add_option("--supersample-contrast", opt.camera.supersample_contrast,
                  "A pixel is supersampled where its neighbourhood sees another surface or the "
