@@ -340,14 +340,16 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
   st.level2_too_wide = int(before_std - groups.size());
   // A bend can also pass Th_delta when it is short: its VPs spread little about their mean but
   // turn steadily with the road. Such a cluster is dropped by the sweep of its headings.
-  const size_t before_sweep = groups.size();
-  groups.erase(std::remove_if(groups.begin(), groups.end(),
-                              [&](const Group& g) {
-                                return IsBend(HeadingTurnAlongPath(cands, path, ground, g),
-                                              options);
-                              }),
-               groups.end());
-  st.level2_turning = int(before_sweep - groups.size());
+  std::vector<Group> straight;
+  std::vector<HeadingTurn> turns;  // Of the kept clusters, for their info.
+  for (Group& g : groups) {
+    const HeadingTurn turn = HeadingTurnAlongPath(cands, path, ground, g);
+    if (IsBend(turn, options)) continue;
+    straight.push_back(std::move(g));
+    turns.push_back(turn);
+  }
+  st.level2_turning = int(groups.size() - straight.size());
+  groups = std::move(straight);
   st.level2_clusters = int(groups.size());
   // Final ids in order of each cluster's first frame.
   std::vector<std::pair<int64_t, int>> first;
@@ -367,7 +369,7 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
     info.members = int(g.members.size());
     info.level1 = g.level1;
     info.slope_deg = SlopeDeg(ground, g.centre);
-    const HeadingTurn turn = HeadingTurnAlongPath(cands, path, ground, g);
+    const HeadingTurn& turn = turns[first[id].second];
     info.sweep_deg = turn.sweep_deg;
     info.turn_rate_deg_per_100m = turn.rate_deg_per_100m;
     result.clusters.push_back(info);

@@ -50,36 +50,36 @@ double ShadeRay(const Scene& scene, const Hit& hit, const Eigen::Vector3d& o,
   return value + w * (sky - value);
 }
 
+// Unit world direction of the ray through image point (u, v).
+Eigen::Vector3d RayThrough(const Eigen::Matrix3d& R, const PinholeCamera& camera, double u,
+                           double v) {
+  return (R * camera.Unproject(Eigen::Vector2d(u, v))).normalized();
+}
+
+// What a centre ray hit: face, -2 - moving box, or -1 (sky).
+int32_t SurfaceId(const Hit& hit) { return hit.dynamic >= 0 ? -2 - hit.dynamic : hit.face; }
+
 // A pixel whose neighbourhood sees one surface: its sub-pixel rays (offsets from the pixel
 // (i, j)) meet the plane of the centre ray's hit, planar at the scale of a pixel, and are shaded
 // there without a ray cast. *value = base + weight x the sum of their radiances. Returns false,
 // *value untouched, when a ray runs (nearly) parallel to the plane or meets it behind the
-// camera or beyond max_range, or when there are more than 16 (supersample > 4): the caller
-// casts the rays then.
+// camera or beyond max_range: the caller casts the rays then.
 bool ShadeOnPlane(const Scene& scene, const Hit& centre, const Eigen::Vector3d& o,
                   const Eigen::Matrix3d& R, const PinholeCamera& camera, int i, int j,
                   const std::vector<Eigen::Vector2d>& offsets, const Eigen::Vector3d& sun,
                   double pixel_angle, const CameraOptions& options, float base, float weight,
                   float* value) {
-  const Eigen::Vector3d dc = (R * camera.Unproject(Eigen::Vector2d(i, j))).normalized();
-  const double plane = centre.normal.dot(dc) * centre.t;  // n . (p - o) for the hit p (< 0).
-  Eigen::Vector3d dirs[16];
-  double ts[16];
-  const size_t n = std::min<size_t>(offsets.size(), 16);
-  for (size_t k = 0; k < n; ++k) {
-    dirs[k] = (R * camera.Unproject(Eigen::Vector2d(i + offsets[k].x(), j + offsets[k].y())))
-                  .normalized();
-    const double cos_n = centre.normal.dot(dirs[k]);
-    if (cos_n > -1e-6) return false;
-    ts[k] = plane / cos_n;
-    if (!(ts[k] > 0.0 && ts[k] <= options.max_range)) return false;
-  }
-  if (n < offsets.size()) return false;
+  // n . (p - o) for the hit p (< 0: the normal faces the camera).
+  const double plane = centre.normal.dot(RayThrough(R, camera, i, j)) * centre.t;
   float sum = base;
-  for (size_t k = 0; k < n; ++k) {
+  for (const Eigen::Vector2d& offset : offsets) {
+    const Eigen::Vector3d d = RayThrough(R, camera, i + offset.x(), j + offset.y());
+    const double cos_n = centre.normal.dot(d);
+    if (cos_n > -1e-6) return false;
     Hit sub = centre;
-    sub.t = ts[k];
-    sum += weight * static_cast<float>(ShadeRay(scene, sub, o, dirs[k], sun, pixel_angle, options));
+    sub.t = plane / cos_n;
+    if (!(sub.t > 0.0 && sub.t <= options.max_range)) return false;
+    sum += weight * static_cast<float>(ShadeRay(scene, sub, o, d, sun, pixel_angle, options));
   }
   *value = sum;
   return true;
@@ -102,24 +102,21 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
   // Pass 1: one ray through every pixel centre.
   const int w = camera.width, h = camera.height;
   cv::Mat radiance(h, w, CV_32F);
-  cv::Mat surface(h, w, CV_32S);  // What the centre ray hits: face, -2 - moving box, -1 sky.
   std::vector<Hit> centre_hits(static_cast<size_t>(w) * static_cast<size_t>(h));
   Eigen::Vector3d dirs[8];
   Hit hits[8];
   for (int j = 0; j < h; ++j) {
     float* row = radiance.ptr<float>(j);
-    int32_t* id = surface.ptr<int32_t>(j);
     for (int i0 = 0; i0 < w; i0 += 8) {
       const int n = std::min(8, w - i0);
       for (int k = 0; k < n; ++k) {
-        dirs[k] = (R * camera.Unproject(Eigen::Vector2d(i0 + k, j))).normalized();
+        dirs[k] = RayThrough(R, camera, i0 + k, j);
       }
       caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
       for (int k = 0; k < n; ++k) {
         IntersectBoxes(near, o, dirs[k], &hits[k]);
         row[i0 + k] =
             static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, pixel_angle, options));
-        id[i0 + k] = hits[k].dynamic >= 0 ? -2 - hits[k].dynamic : hits[k].face;
         centre_hits[static_cast<size_t>(j) * w + i0 + k] = hits[k];
       }
     }
@@ -159,12 +156,13 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
       float* row = radiance.ptr<float>(j);
       for (int i = 0; i < w; ++i) {
         const float c = centre.at<float>(j, i);
-        const int32_t f = surface.at<int32_t>(j, i);
+        const Hit& hit = centre_hits[static_cast<size_t>(j) * w + i];
+        const int32_t f = SurfaceId(hit);
         bool other_surface = false;
         for (int y = std::max(0, j - 1); y <= std::min(h - 1, j + 1); ++y) {
-          const int32_t* sr = surface.ptr<int32_t>(y);
+          const Hit* hits_row = &centre_hits[static_cast<size_t>(y) * w];
           for (int x = std::max(0, i - 1); x <= std::min(w - 1, i + 1); ++x) {
-            other_surface = other_surface || sr[x] != f;
+            other_surface = other_surface || SurfaceId(hits_row[x]) != f;
           }
         }
         // Second differences (borders replicate the edge pixel).
@@ -180,9 +178,8 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
         const bool edge = curvature > contrast;
         if (other_surface || (edge && f < 0)) {
           cast.push_back(i);
-        } else if (edge && !ShadeOnPlane(scene, centre_hits[static_cast<size_t>(j) * w + i], o, R,
-                                         camera, i, j, offsets, sun, pixel_angle, options,
-                                         centre_weight * c, weight, &row[i])) {
+        } else if (edge && !ShadeOnPlane(scene, hit, o, R, camera, i, j, offsets, sun, pixel_angle,
+                                         options, centre_weight * c, weight, &row[i])) {
           cast.push_back(i);  // A sub-pixel ray misses the plane (grazing view): cast them all.
         }
       }
@@ -196,8 +193,7 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
           const int64_t r = r0 + k;
           pixel[k] = cast[static_cast<size_t>(r / rays)];
           const Eigen::Vector2d& d = offsets[static_cast<size_t>(r % rays)];
-          dirs[k] =
-              (R * camera.Unproject(Eigen::Vector2d(pixel[k] + d.x(), j + d.y()))).normalized();
+          dirs[k] = RayThrough(R, camera, pixel[k] + d.x(), j + d.y());
         }
         caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
         for (int k = 0; k < n; ++k) {

@@ -75,7 +75,6 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
   std::array<float, n> current{};
   // Stage 0: translation and brightness; stage 1 (options.affine): also the 2 x 2 warp.
   const int stages = options.affine ? 2 : 1;
-  bool converged = false;
   for (int stage = 0; stage < stages; ++stage) {
     const int np = stage == 0 ? 4 : 8;
     for (int it = 0; it <= options.iterations; ++it) {
@@ -92,8 +91,13 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
           const double r = v - a * t - b;
           Eigen::Matrix<double, 8, 1> j;
           j << gx, gy, -t, -1.0, gx * dx, gx * dy, gy * dx, gy * dy;
-          h += j * j.transpose();
-          g += j * r;
+          if (np == 4) {  // The warp's rows and columns are not used in this stage.
+            h.topLeftCorner<4, 4>() += j.head<4>() * j.head<4>().transpose();
+            g.head<4>() += j.head<4>() * r;
+          } else {
+            h += j * j.transpose();
+            g += j * r;
+          }
         }
       }
       if (stage == 0 && it == 0) {
@@ -141,13 +145,9 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
       // Converged when no patch sample moves by more than ~1e-3 level pixels.
       const double move = d.head<2>().squaredNorm() +
                           (np == 8 ? kPatchRadius * kPatchRadius * d.tail<4>().squaredNorm() : 0.0);
-      if (move < 1e-6) {
-        converged = true;
-        break;
-      }
+      if (move < 1e-6) break;
     }
   }
-  (void)converged;
   // Resample at the final position for the correlation.
   int k = 0;
   for (int yy = -kPatchRadius; yy <= kPatchRadius; ++yy) {
