@@ -527,7 +527,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
       o.beta = w.beta;
       o.gamma = w.gamma;
       auto built = optim::BuildJointProblem(only, o);
-      direction_before = optim::EvaluateJointCost(built, options.solve.threads).direction;
+      direction_before = optim::EvaluateJointCost(built).direction;
     }
     optim::SolveOptions solve = options.solve;
     if (!solve.progress_label.empty())

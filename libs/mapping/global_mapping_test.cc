@@ -424,8 +424,7 @@ TEST(GlobalMapping, DISABLED_Sequence4500Frames) {
       static_cast<long long>(r.solve.before.direction.count),
       static_cast<double>(PeakMemoryBytes()) / (1 << 20), ape_prior.translation_m,
       ape.translation_m);
-  EXPECT_TRUE(r.solve.usable);
-  EXPECT_LT(r.total_time_s, 120.0);
+  EXPECT_TRUE(r.solve.usable);  // the time is printed above, not asserted (machine-dependent)
   EXPECT_LT(PeakMemoryBytes(), int64_t{4} << 30);
 }
 

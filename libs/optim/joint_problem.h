@@ -164,11 +164,13 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
 
 struct SolveOptions {
   int max_iterations = 100;
+  // Threads of the work around the solve (IMLS traversal, scan preparation); Ceres itself runs
+  // on one thread so that the result does not depend on this (joint_stats.cc).
   int threads = 1;
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
-  double max_time_s = 1e9;
+  double max_time_s = 1e9;  // a wall-clock limit makes results machine-dependent: tests only
   bool log_progress = false;  // Ceres' per-iteration log on stderr
   // Non-empty: one info log line per LM iteration ("<label> iteration k: cost, time"), the
   // progress of long solves.
@@ -210,7 +212,7 @@ struct JointSolveResult {
   std::vector<Eigen::Vector3d> free_directions;  // optimised free d_w blocks (unit)
 };
 
-JointCostBreakdown EvaluateJointCost(JointProblem& problem, int threads);
+JointCostBreakdown EvaluateJointCost(JointProblem& problem);
 JointSolveResult SolveJointProblem(JointProblem& problem, const SolveOptions& options);
 // Build + solve.
 JointSolveResult OptimizeJoint(const JointProblemInput& input, const JointProblemOptions& options,

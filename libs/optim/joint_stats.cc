@@ -17,13 +17,13 @@ namespace {
 // `count`: residuals represented by the blocks (a compressed IMLS block stands for all the
 // correspondences of its keyframe pair and its squared norm is their sum of squares).
 ResidualStats Evaluate(ceres::Problem& problem, const std::vector<ceres::ResidualBlockId>& ids,
-                       int64_t count, int threads) {
+                       int64_t count) {
   ResidualStats stats;
   stats.count = count;
   if (ids.empty()) return stats;  // an empty list would mean "all residual blocks" to Ceres
   ceres::Problem::EvaluateOptions options;
   options.residual_blocks = ids;
-  options.num_threads = threads;
+  options.num_threads = 1;  // a fixed order of the sums (see MakeSolverOptions)
   options.apply_loss_function = true;
   problem.Evaluate(options, &stats.cost, nullptr, nullptr, nullptr);
   // Whitened residuals without weight or robust kernel: comparable across weight settings.
@@ -41,7 +41,12 @@ ceres::Solver::Options MakeSolverOptions(JointProblem& jp, const SolveOptions& o
   so.minimizer_type = ceres::TRUST_REGION;
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;  // as in the paper
   so.max_num_iterations = options.max_iterations;
-  so.num_threads = options.threads;
+  // One thread, whatever options.threads says: Ceres' multi-threaded reductions (the cost, the
+  // gradient, the Schur complement) add up in the order its threads finish, so results would
+  // differ in the last bits from run to run, and those bits can flip a step's acceptance or the
+  // convergence test. On one thread the result does not depend on the thread count at all
+  // (measured on the demo's local_map: 16 % slower than with 2 Ceres threads).
+  so.num_threads = 1;
   so.function_tolerance = options.function_tolerance;
   so.gradient_tolerance = options.gradient_tolerance;
   so.parameter_tolerance = options.parameter_tolerance;
@@ -98,15 +103,15 @@ void SolveOptions::Check() const {
   JVL_CHECK(max_time_s > 0, "max_time_s must be positive");
 }
 
-JointCostBreakdown EvaluateJointCost(JointProblem& jp, int threads) {
+JointCostBreakdown EvaluateJointCost(JointProblem& jp) {
   JointCostBreakdown b;
   int64_t imls_count = 0;
   for (int64_t c : jp.imls_block_counts) imls_count += c;
-  b.visual = Evaluate(*jp.problem, jp.visual_blocks,
-                      static_cast<int64_t>(jp.visual_blocks.size()), threads);
-  b.imls = Evaluate(*jp.problem, jp.imls_blocks, imls_count, threads);
+  b.visual =
+      Evaluate(*jp.problem, jp.visual_blocks, static_cast<int64_t>(jp.visual_blocks.size()));
+  b.imls = Evaluate(*jp.problem, jp.imls_blocks, imls_count);
   b.direction = Evaluate(*jp.problem, jp.direction_blocks,
-                        static_cast<int64_t>(jp.direction_blocks.size()), threads);
+                         static_cast<int64_t>(jp.direction_blocks.size()));
   b.total = b.visual.cost + b.imls.cost + b.direction.cost;
   return b;
 }
@@ -123,7 +128,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   result.gated_points = jp.gated_points;
   result.weak_points = jp.weak_points;
   Timer phase;
-  if (options.evaluate_before) result.before = EvaluateJointCost(jp, options.threads);
+  if (options.evaluate_before) result.before = EvaluateJointCost(jp);
   const double before_s = phase.ElapsedSeconds();
   ceres::Solver::Options so = MakeSolverOptions(jp, options);
   ProgressLog progress(options.progress_label);
@@ -141,7 +146,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   result.linear_solver = ceres::LinearSolverTypeToString(so.linear_solver_type);
   phase.Reset();
   if (options.evaluate_after || !result.usable)
-    result.after = EvaluateJointCost(jp, options.threads);
+    result.after = EvaluateJointCost(jp);
   spdlog::debug(
       "joint solve: cost by term {:.1f} s before, {:.1f} s after; Ceres preprocessor {:.1f} s, "
       "minimizer {:.1f} s (Jacobians {:.1f} s, residuals {:.1f} s, linear solver {:.1f} s), "
