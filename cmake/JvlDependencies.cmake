@@ -12,6 +12,8 @@ else()
   message(STATUS "opencv_ximgproc not found: only the LSD line detector is available")
 endif()
 find_package(Ceres REQUIRED)
+# glog comes with Ceres (it logs through it); the tools silence it (app/tool.cc).
+find_package(glog CONFIG REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)

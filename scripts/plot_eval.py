@@ -95,6 +95,7 @@ def plot_ape_box(data, path):
 
 def plot_kitti(data, path):
     fig, (ax_t, ax_r) = plt.subplots(1, 2, figsize=(11, 4.5))
+    drawn = 0
     for est in data["estimates"]:
         rows = [r for r in est["kitti_per_length"] if r[1] > 0]  # [length, count, t, r]
         if not rows:
@@ -102,13 +103,18 @@ def plot_kitti(data, path):
         rows = np.asarray(rows, float)
         ax_t.plot(rows[:, 0], rows[:, 2], "s-", label=est["label"])
         ax_r.plot(rows[:, 0], rows[:, 3], "s-", label=est["label"])
+        drawn += 1
     ax_t.set_xlabel("segment length (m)")
     ax_t.set_ylabel("translation error t_rel (%)")
     ax_r.set_xlabel("segment length (m)")
     ax_r.set_ylabel("rotation error r_rel (deg/100 m)")
     for ax in (ax_t, ax_r):
         ax.grid(True, alpha=0.3)
-        ax.legend(loc="best")
+        if drawn:
+            ax.legend(loc="best")
+        else:
+            ax.text(0.5, 0.5, "no KITTI segment\n(path shorter than the shortest length)",
+                    ha="center", va="center", transform=ax.transAxes)
     fig.suptitle("KITTI segment errors per length")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -133,7 +139,7 @@ def main():
         path = os.path.join(out, stem + ".png")
         fn(data, path)
         written.append(path)
-    print("plot_eval: wrote " + ", ".join(os.path.basename(p) for p in written), file=sys.stderr)
+    print("plot_eval: wrote " + ", ".join(os.path.basename(p) for p in written))
 
 
 if __name__ == "__main__":

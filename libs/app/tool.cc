@@ -2,11 +2,15 @@
 
 #include <spdlog/spdlog.h>
 
+#include <glog/logging.h>
+
 #include <cstdio>
+#include <thread>
 
 #include "core/check.h"
 #include "core/logging.h"
 #include "core/threads.h"
+#include "io/files.h"
 #include "io/version.h"
 
 namespace jvl::app {
@@ -16,6 +20,7 @@ Tool::Tool(std::string name, std::string description)
   cli_.set_version_flag("--version", std::string(name_) + " (jvldloc) " + JVL_VERSION + " " +
                                          JVL_GIT_REVISION);
   cli_.set_config("--config", "", "Read options from a TOML/INI file (same names as the flags)");
+  cli_.allow_config_extras(CLI::config_extras_mode::error);
   cli_.add_option("--threads", threads_, "Worker threads (0 = all cores)")->capture_default_str();
   cli_.add_option("--log-level", log_level_, "trace, debug, info, warn, error or off")
       ->capture_default_str();
@@ -24,6 +29,17 @@ Tool::Tool(std::string name, std::string description)
 }
 
 int Tool::Run(int argc, const char* const* argv, const std::function<void()>& body) {
+  // Unsigned options (seeds, counts): CLI11 would read "-1" as 2^64 - 1.
+  const CLI::Validator non_negative(
+      [](std::string& value) {
+        return !value.empty() && value.front() == '-'
+                   ? "must be a non-negative integer, got " + value
+                   : std::string();
+      },
+      "", "non-negative");
+  for (CLI::Option* option : cli_.get_options()) {
+    if (option->get_type_name() == "UINT") option->check(non_negative);
+  }
   try {
     cli_.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -32,13 +48,38 @@ int Tool::Run(int argc, const char* const* argv, const std::function<void()>& bo
     return cli_.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return cli_.exit(e);
+  } catch (const CLI::ConfigError& e) {
+    // CLI11 names the key but not the file.
+    const CLI::Option* config = cli_.get_config_ptr();
+    const std::string file = config && !config->results().empty() ? config->results()[0] : "";
+    std::fprintf(stderr, "%s: error: %s%s (see --help)\n", name_.c_str(),
+                 file.empty() ? "" : (file + ": ").c_str(), e.what());
+    return 2;
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "%s: error: %s (see --help)\n", name_.c_str(), e.what());
     return 2;
   }
   try {
     SetupLogging(log_level_);
+    io::InstallInterruptCleanup();
+    // Ceres logs through glog: keep its lines (e.g. thread-count notices) off the terminal;
+    // the tools report what matters through their own log.
+    static bool glog_ready = false;
+    if (!glog_ready) {
+      FLAGS_minloglevel = 3;  // FATAL only
+      FLAGS_logtostderr = true;
+      google::InitGoogleLogging(name_.c_str());
+      glog_ready = true;
+    }
+    const int requested = threads_;
     threads_ = ResolveThreadCount(threads_);
+    const unsigned hw = std::thread::hardware_concurrency();
+    if (hw > 0 && threads_ > static_cast<int>(hw)) {
+      spdlog::warn("--threads {}: this machine has {} hardware threads; using {}", requested, hw,
+                   hw);
+      threads_ = static_cast<int>(hw);
+    }
+    CheckOutputs();
     timer_.Reset();
     body();
     return 0;
@@ -62,7 +103,68 @@ void Tool::SetDatasetId(const std::string& id, const std::string& source) {
   dataset_source_ = source;
 }
 
+CLI::Option* Tool::OutputFile(CLI::Option* option) {
+  output_options_.push_back(option);
+  return option;
+}
+
+CLI::Option* Tool::InputFile(CLI::Option* option) {
+  input_options_.push_back(option);
+  return option;
+}
+
+namespace {
+
+std::string OptionName(const CLI::Option* option) {
+  return option->get_lnames().empty() ? option->get_name() : "--" + option->get_lnames()[0];
+}
+
+}  // namespace
+
+void Tool::CheckOutputs() const {
+  for (size_t a = 0; a < output_options_.size(); ++a) {
+    for (const std::string& pa : output_options_[a]->results()) {
+      if (pa.empty()) continue;
+      JVL_CHECK(!io::IsDirectory(pa), OptionName(output_options_[a])
+                                          << " " << pa << ": is a folder (expected a file name)");
+      for (size_t b = a + 1; b < output_options_.size(); ++b) {
+        for (const std::string& pb : output_options_[b]->results()) {
+          JVL_CHECK(pb.empty() || !io::SameFile(pa, pb),
+                    OptionName(output_options_[a])
+                        << " " << pa << " and " << OptionName(output_options_[b]) << " " << pb
+                        << " are the same file (each output needs its own path)");
+        }
+      }
+    }
+  }
+  for (const CLI::Option* in : input_options_)
+    for (const std::string& path : in->results())
+      if (!path.empty()) CheckNotAnOutput(path, OptionName(in));
+}
+
+void Tool::CheckNotAnOutput(const std::string& path, const std::string& what) const {
+  for (const CLI::Option* out : output_options_) {
+    for (const std::string& o : out->results()) {
+      JVL_CHECK(o.empty() || !io::SameFile(o, path),
+                "output " << OptionName(out) << " " << o << " is the same file as input " << what
+                          << " " << path << " (refusing to overwrite an input)");
+    }
+  }
+}
+
+void Tool::AddDataset(const io::Dataset& dataset, const std::string& source) {
+  SetDatasetId(dataset.id(), source);
+  for (const std::string& f : dataset.KeyFiles()) AddInput(f);
+  // Only outputs that already exist can be a dataset file; most runs skip the listing.
+  bool any_exists = false;
+  for (const CLI::Option* out : output_options_)
+    for (const std::string& o : out->results()) any_exists |= !o.empty() && io::FileExists(o);
+  if (!any_exists) return;
+  for (const std::string& f : dataset.InputFiles()) CheckNotAnOutput(f, "dataset file");
+}
+
 void Tool::AddInput(const std::string& path, bool same_dataset) {
+  CheckNotAnOutput(path, "file");
   inputs_.push_back(io::DescribeFile(path));
   if (!same_dataset) return;
   const std::string id = io::ReadArtifactDatasetId(path);

@@ -19,6 +19,7 @@
 
 #include "core/timer.h"
 #include "io/artifact.h"
+#include "io/dataset.h"
 
 namespace jvl::app {
 
@@ -34,6 +35,17 @@ class Tool {
   // Parses argv and runs body. Returns the process exit code.
   int Run(int argc, const char* const* argv, const std::function<void()>& body);
 
+  // Marks an option as naming a file this tool writes. Before the body runs, Run() refuses two
+  // outputs that are the same file, and an output that is the same file as an input option
+  // (InputFile); AddInput and AddDataset refuse inputs that are outputs. "The same file" is
+  // decided on resolved paths: symbolic links, "./" and hard links are seen through.
+  CLI::Option* OutputFile(CLI::Option* option);
+  // Marks an option as naming a file or folder this tool reads (checked against the outputs).
+  CLI::Option* InputFile(CLI::Option* option);
+  // Records a dataset as input: its sequence id (SetDatasetId), its key files (AddInput), and
+  // refuses an output that is one of the files the dataset's frames are read from.
+  void AddDataset(const io::Dataset& dataset, const std::string& source);
+
   // Records an input file (path, size, content hash) for the provenance. The dataset id in an
   // artifact's provenance must match the run's (from SetDatasetId or an earlier input), so that
   // artifacts of different sequences are not mixed; the first one seen becomes the run's id.
@@ -47,8 +59,13 @@ class Tool {
   nlohmann::json OptionsJson() const;
 
  private:
+  // Throws if `path` (an input, named by `what`) is the same file as one of the outputs.
+  void CheckNotAnOutput(const std::string& path, const std::string& what) const;
+  void CheckOutputs() const;
+
   std::string name_;
   CLI::App cli_;
+  std::vector<CLI::Option*> output_options_, input_options_;
   int threads_ = 0;
   std::string log_level_ = "info";
   bool quiet_ = false;

@@ -1,6 +1,7 @@
 #include "eval/evaluate.h"
 
 #include <Eigen/LU>
+#include <limits>
 
 #include "core/check.h"
 
@@ -85,7 +86,7 @@ EstimateEval CombineSequences(std::string label, std::vector<SequenceEval> seque
   std::vector<const std::vector<double>*> ape_t, ape_r, rpe_t, rpe_p, rpe_r;
   std::vector<const ApeComponents*> components;
   std::vector<KittiSegment> segments;
-  double t_sum = 0, r_sum = 0;
+  double t_sum = 0, r_sum = 0, scored = 0;
   for (const SequenceEval& s : sequences) {
     e.frames_matched += s.frames_matched;
     ape_t.push_back(&s.ape.translation_m);
@@ -95,8 +96,11 @@ EstimateEval CombineSequences(std::string label, std::vector<SequenceEval> seque
     rpe_p.push_back(&s.rpe.translation_percent);
     rpe_r.push_back(&s.rpe.rotation_deg);
     segments.insert(segments.end(), s.kitti.segments.begin(), s.kitti.segments.end());
-    t_sum += s.kitti.t_rel_percent;
-    r_sum += s.kitti.r_rel_deg_per_100m;
+    if (!s.kitti.segments.empty()) {  // sequences without a segment have no score
+      t_sum += s.kitti.t_rel_percent;
+      r_sum += s.kitti.r_rel_deg_per_100m;
+      ++scored;
+    }
   }
   e.ape_translation = PoolStats(ape_t);
   e.ape_rotation = PoolStats(ape_r);
@@ -105,8 +109,10 @@ EstimateEval CombineSequences(std::string label, std::vector<SequenceEval> seque
   e.rpe_percent = PoolStats(rpe_p);
   e.rpe_rotation = PoolStats(rpe_r);
   e.kitti_pooled = SummarizeSegments(std::move(segments), kitti_options.lengths);
-  e.kitti_mean_t_rel_percent = t_sum / static_cast<double>(sequences.size());
-  e.kitti_mean_r_rel_deg_per_100m = r_sum / static_cast<double>(sequences.size());
+  e.kitti_mean_t_rel_percent =
+      scored > 0 ? t_sum / scored : std::numeric_limits<double>::quiet_NaN();
+  e.kitti_mean_r_rel_deg_per_100m =
+      scored > 0 ? r_sum / scored : std::numeric_limits<double>::quiet_NaN();
   e.sequences = std::move(sequences);
   return e;
 }

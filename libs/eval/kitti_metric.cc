@@ -1,5 +1,7 @@
 #include "eval/kitti_metric.h"
 
+#include <limits>
+
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -47,7 +49,10 @@ KittiResult ComputeKitti(const PairedPoses& paired, const std::vector<double>& g
 
 KittiResult SummarizeSegments(std::vector<KittiSegment> segments,
                               const std::vector<double>& lengths) {
+  // No segment (a path shorter than the shortest length): the score is undefined, not 0.
+  constexpr double kUndefined = std::numeric_limits<double>::quiet_NaN();
   KittiResult r;
+  r.t_rel_percent = r.r_rel_deg_per_100m = kUndefined;
   double t_sum = 0, r_sum = 0;
   for (const KittiSegment& s : segments) t_sum += s.t_err, r_sum += s.r_err;
   if (!segments.empty()) {
@@ -58,6 +63,7 @@ KittiResult SummarizeSegments(std::vector<KittiSegment> segments,
   for (double length : lengths) {
     KittiLengthRow row;
     row.length_m = length;
+    row.t_rel_percent = row.r_rel_deg_per_100m = kUndefined;
     double t = 0, rr = 0;
     for (const KittiSegment& s : segments) {
       if (s.length_m != length) continue;

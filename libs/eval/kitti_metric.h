@@ -27,12 +27,14 @@ struct KittiSegment {
 struct KittiLengthRow {
   double length_m = 0;
   int64_t count = 0;
-  double t_rel_percent = 0, r_rel_deg_per_100m = 0;  // Means over the segments of this length.
+  // Means over the segments of this length; NaN when there is none.
+  double t_rel_percent = 0, r_rel_deg_per_100m = 0;
 };
 
 struct KittiResult {
   std::vector<KittiSegment> segments;
   std::vector<KittiLengthRow> per_length;
+  // NaN when there is no segment (path shorter than the shortest length): undefined, not 0.
   double t_rel_percent = 0;       // Mean t_err * 100 over all segments.
   double r_rel_deg_per_100m = 0;  // Mean r_err * 180 / pi * 100 over all segments.
 };

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "eval/test_util.h"
 
 namespace jvl::eval {
@@ -74,8 +76,11 @@ TEST(Kitti, TooShortHasNoSegments) {
   const PoseSeries gt = testing::StraightLine(50);
   const KittiResult k = ComputeKitti(Pair(gt, gt), TrajectoryDistances(gt.poses), {});
   EXPECT_TRUE(k.segments.empty());
-  EXPECT_EQ(k.t_rel_percent, 0);
+  // Undefined, not 0 (a perfect-looking score): NaN, written as null and shown as n/a.
+  EXPECT_TRUE(std::isnan(k.t_rel_percent));
+  EXPECT_TRUE(std::isnan(k.r_rel_deg_per_100m));
   EXPECT_EQ(k.per_length[0].count, 0);
+  EXPECT_TRUE(std::isnan(k.per_length[0].t_rel_percent));
 }
 
 }  // namespace

@@ -1,20 +1,25 @@
 #include "eval/report.h"
 
+#include <cmath>
+
 namespace jvl::eval {
 
 namespace {
 
+// An undefined score (no segment) is null in the report.
+nlohmann::json Score(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
 nlohmann::json KittiToJson(const KittiResult& k) {
   nlohmann::json j;
-  j["t_rel_percent"] = k.t_rel_percent;
-  j["r_rel_deg_per_100m"] = k.r_rel_deg_per_100m;
+  j["t_rel_percent"] = Score(k.t_rel_percent);
+  j["r_rel_deg_per_100m"] = Score(k.r_rel_deg_per_100m);
   j["segments"] = static_cast<int64_t>(k.segments.size());
   j["per_length"] = nlohmann::json::array();
   for (const KittiLengthRow& row : k.per_length) {
     j["per_length"].push_back({{"length_m", row.length_m},
                                {"segments", row.count},
-                               {"t_rel_percent", row.t_rel_percent},
-                               {"r_rel_deg_per_100m", row.r_rel_deg_per_100m}});
+                               {"t_rel_percent", Score(row.t_rel_percent)},
+                               {"r_rel_deg_per_100m", Score(row.r_rel_deg_per_100m)}});
   }
   return j;
 }
@@ -106,8 +111,9 @@ nlohmann::json EstimateToJson(const EstimateEval& e, const EvalOptions& options)
   // Pooled over all segments of all sequences (devkit); equal to the sequence's for one.
   j["kitti"] = KittiToJson(e.kitti_pooled);
   j["kitti"]["pooling"] = "all segments of all sequences (KITTI devkit)";
-  j["kitti"]["mean_of_sequences"] = {{"t_rel_percent", e.kitti_mean_t_rel_percent},
-                                     {"r_rel_deg_per_100m", e.kitti_mean_r_rel_deg_per_100m}};
+  j["kitti"]["mean_of_sequences"] = {
+      {"t_rel_percent", Score(e.kitti_mean_t_rel_percent)},
+      {"r_rel_deg_per_100m", Score(e.kitti_mean_r_rel_deg_per_100m)}};
   if (e.sequences.size() == 1) {
     j["alignment"] = AlignmentToJson(e.sequences.front(), options);
   } else {

@@ -1,5 +1,6 @@
 // Text, Markdown and plot-data views of an evaluation (declared in report.h).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -11,6 +12,7 @@ namespace {
 
 // Six significant digits: enough to compare by eye; metrics.json keeps every digit.
 std::string Num(double v) {
+  if (std::isnan(v)) return "n/a";  // an undefined score (no KITTI segment)
   char buf[64];
   std::snprintf(buf, sizeof(buf), "%.6g", v);
   return buf;
@@ -72,8 +74,15 @@ std::string Header(const EvalOptions& o) {
   return os.str();
 }
 
-std::string MeanOfSequencesNote(const std::vector<EstimateEval>& estimates) {
+std::string MeanOfSequencesNote(const std::vector<EstimateEval>& estimates,
+                                const EvalOptions& options) {
   std::ostringstream os;
+  for (const EstimateEval& e : estimates) {
+    if (!e.kitti_pooled.segments.empty()) continue;
+    os << "t_rel and r_rel of " << e.label << " are n/a: its path is shorter than the shortest "
+       << "KITTI segment (" << Num(options.kitti.lengths.front())
+       << " m), so the score is undefined\n";
+  }
   for (const EstimateEval& e : estimates) {
     if (e.sequences.size() < 2) continue;
     os << "mean of per-sequence KITTI scores, " << e.label << ": t_rel "
@@ -107,7 +116,7 @@ std::string FormatTable(const std::vector<EstimateEval>& estimates, const EvalOp
   for (size_t w : width) total += w + 2;
   os << std::string(total - 2, '-') << "\n";
   for (const auto& row : cells) line(row);
-  os << MeanOfSequencesNote(estimates);
+  os << MeanOfSequencesNote(estimates, options);
   return os.str();
 }
 
@@ -125,7 +134,7 @@ std::string FormatMarkdown(const std::vector<EstimateEval>& estimates, const Eva
     for (const auto& cell : Cells(r)) os << " " << cell << " |";
     os << "\n";
   }
-  const std::string note = MeanOfSequencesNote(estimates);
+  const std::string note = MeanOfSequencesNote(estimates, options);
   if (!note.empty()) os << "\n" << note;
   os << "\n## APE along the path and about the camera axes (RMS)\n\n"
      << "Position error in the ground truth's path frame (along the direction of travel, lateral, "

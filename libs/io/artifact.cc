@@ -155,6 +155,7 @@ nlohmann::json Provenance::ToJson() const {
 // ---------------------------------------------------------------------------------------------
 struct H5Writer::Impl {
   std::string path, tmp, schema;
+  std::unique_ptr<PendingTempFile> pending;  // removes tmp on SIGINT/SIGTERM
   int version = 0;
   hid_t file = -1;
   bool committed = false;
@@ -189,7 +190,8 @@ H5Writer::H5Writer(std::string path, std::string schema, int schema_version)
   impl_->version = schema_version;
   const std::filesystem::path p(impl_->path);
   if (p.has_parent_path()) CreateDirectories(p.parent_path().string());
-  impl_->tmp = impl_->path + ".tmp." + std::to_string(::getpid());
+  impl_->tmp = TempPathFor(impl_->path);
+  impl_->pending = std::make_unique<PendingTempFile>(impl_->tmp);
   Handle fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
   H5Pset_obj_track_times(fcpl.get(), 0);
   impl_->file = H5Fcreate(impl_->tmp.c_str(), H5F_ACC_TRUNC, fcpl.get(), H5P_DEFAULT);
@@ -516,6 +518,15 @@ void WriteJsonArtifact(const std::string& path, const std::string& schema, int s
   WriteTextFileAtomic(path, j.dump(2) + "\n");
 }
 
+std::string JsonErrorText(const std::exception& e) {
+  std::string text = e.what();
+  if (text.rfind("[json.exception.", 0) == 0) {
+    const size_t end = text.find("] ");
+    if (end != std::string::npos) text.erase(0, end + 2);
+  }
+  return text;
+}
+
 nlohmann::json ReadJsonArtifact(const std::string& path, const std::string& schema,
                                 int schema_version) {
   JVL_CHECK(FileExists(path), path << ": file not found");
@@ -523,7 +534,7 @@ nlohmann::json ReadJsonArtifact(const std::string& path, const std::string& sche
   try {
     j = nlohmann::json::parse(ReadTextFile(path));
   } catch (const nlohmann::json::exception& e) {
-    JVL_THROW(path << ": not valid JSON (truncated?): " << e.what());
+    JVL_THROW(path << ": not valid JSON (truncated?): " << JsonErrorText(e));
   }
   JVL_CHECK(j.is_object() && j.contains("schema") && j.contains("schema_version"),
             path << ": not a jvl artifact (no schema field); expected schema '" << schema << "'");

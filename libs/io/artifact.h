@@ -98,6 +98,10 @@ class H5Reader {
 // text) and artifacts without one.
 std::string ReadArtifactDatasetId(const std::string& path);
 
+// The message of a JSON library error without the library's "[json.exception.<id>] " prefix,
+// e.g. "parse error at line 1, column 5: syntax error ...".
+std::string JsonErrorText(const std::exception& e);
+
 // JSON artifacts: {"schema": ..., "schema_version": ..., "provenance": {...}, ...body}.
 void WriteJsonArtifact(const std::string& path, const std::string& schema, int schema_version,
                        const nlohmann::json& body, const Provenance& provenance);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 
@@ -56,6 +57,12 @@ std::map<int64_t, std::string> ListNumberedFiles(const fs::path& dir, const std:
   return files;
 }
 
+std::vector<int64_t> Keys(const std::map<int64_t, std::string>& files) {
+  std::vector<int64_t> keys;
+  for (const auto& [id, path] : files) keys.push_back(id);
+  return keys;
+}
+
 std::string HashFiles(const std::vector<std::string>& paths) {
   Fnv1a64 hash;
   for (const auto& p : paths) {
@@ -66,34 +73,70 @@ std::string HashFiles(const std::vector<std::string>& paths) {
   return hash.Hex().substr(0, 8);
 }
 
+}  // namespace
+
+std::vector<int64_t> DatasetFrames(const std::vector<int64_t>& scan_ids,
+                                   const std::vector<int64_t>& image_ids, const std::string& dir) {
+  JVL_CHECK(!scan_ids.empty() || !image_ids.empty(),
+            dir << ": no frames found (no scans or images)");
+  int64_t first = std::numeric_limits<int64_t>::max(), last = -1;
+  for (const auto* ids : {&scan_ids, &image_ids}) {
+    if (ids->empty()) continue;
+    first = std::min(first, ids->front());
+    last = std::max(last, ids->back());
+  }
+  std::vector<int64_t> all;
+  for (int64_t f = first; f <= last; ++f) all.push_back(f);
+  return all;
+}
+
 void SelectFrames(const std::vector<int64_t>& all, const FrameRange& range, const std::string& dir,
                   std::vector<int64_t>* selected) {
   JVL_CHECK(!all.empty(), dir << ": no frames found (no scans or images)");
   for (int64_t f : all)
     if (range.Contains(f)) selected->push_back(f);
-  JVL_CHECK(!selected->empty(), "--frames " << range.first << ":"
-                                            << (range.last_exclusive < 0 ? std::string()
-                                                                         : std::to_string(range.last_exclusive))
-                                            << " selects no frame of " << dir << " (frames "
+  const std::string text =
+      std::to_string(range.first) + ":" +
+      (range.last_exclusive < 0 ? std::string() : std::to_string(range.last_exclusive));
+  JVL_CHECK(!selected->empty(), "--frames " << text << " selects no frame of " << dir << " (frames "
                                             << all.front() << ".." << all.back() << ")");
+  JVL_CHECK(range.last_exclusive <= all.back() + 1,
+            "--frames " << text << " goes past the last frame of " << dir << " (frames "
+                        << all.front() << ".." << all.back() << "; use " << range.first
+                        << ": for the rest)");
 }
 
 PointCloud LoadScanChecked(const std::string& path, int64_t frame, size_t* dropped) {
   JVL_CHECK(FileExists(path), path << ": missing scan for frame " << frame);
-  size_t bad = 0;
-  PointCloud cloud = ReadVelodyneBin(path, &bad);
-  if (bad > 0) {
-    spdlog::warn("{}: dropped {} non-finite points (frame {})", path, bad, frame);
+  size_t bad = 0, far = 0;
+  PointCloud cloud = ReadVelodyneBin(path, &bad, &far);
+  if (bad > 0) spdlog::warn("{}: dropped {} non-finite points (frame {})", path, bad, frame);
+  if (far > 0) {
+    spdlog::warn("{}: dropped {} points farther than {:.0f} m (frame {})", path, far, kMaxScanRange,
+                 frame);
   }
   if (cloud.empty()) spdlog::warn("{}: empty scan (frame {})", path, frame);
   if (dropped) *dropped = bad;
   return cloud;
 }
 
-cv::Mat LoadImageChecked(const std::string& path, int64_t frame, int camera) {
-  JVL_CHECK(FileExists(path), path << ": missing image of camera " << camera << " for frame " << frame);
-  return ReadImage(path, camera < 2);
+cv::Mat LoadImageChecked(const std::string& path, int64_t frame, int camera,
+                         const Calibration& calibration, const std::string& size_source) {
+  JVL_CHECK(FileExists(path),
+            path << ": missing image of camera " << camera << " for frame " << frame);
+  cv::Mat image = ReadImage(path, camera < 2);
+  JVL_CHECK(image.cols >= kMinImageSide && image.rows >= kMinImageSide,
+            path << ": image is " << image.cols << "x" << image.rows << ", too small (at least "
+                 << kMinImageSide << "x" << kMinImageSide << ")");
+  JVL_CHECK(calibration.image_width <= 0 ||
+                (image.cols == calibration.image_width && image.rows == calibration.image_height),
+            path << ": image is " << image.cols << "x" << image.rows << " but the sequence's are "
+                 << calibration.image_width << "x" << calibration.image_height << " (from "
+                 << size_source << ")");
+  return image;
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 class KittiOdometryDataset : public Dataset {
@@ -105,8 +148,7 @@ class KittiOdometryDataset : public Dataset {
     calibration_ = ReadKittiCalibration((p / "calib.txt").string());
     const auto scans = ListNumberedFiles(p / "velodyne", ".bin");
     const auto images = ListNumberedFiles(p / "image_0", ".png");
-    std::vector<int64_t> all;
-    for (const auto& [id, path] : scans.empty() ? images : scans) all.push_back(id);
+    const std::vector<int64_t> all = DatasetFrames(Keys(scans), Keys(images), dir);
     SelectFrames(all, range, dir, &frames_);
 
     const std::string times_path = (p / "times.txt").string();
@@ -122,11 +164,16 @@ class KittiOdometryDataset : public Dataset {
     }
     if (!images.empty()) {
       const cv::Mat first = ReadImage(images.begin()->second, true);
+      JVL_CHECK(first.cols >= kMinImageSide && first.rows >= kMinImageSide,
+                images.begin()->second << ": image is " << first.cols << "x" << first.rows
+                                       << ", too small (at least " << kMinImageSide << "x"
+                                       << kMinImageSide << ")");
       calibration_.image_width = first.cols;
       calibration_.image_height = first.rows;
+      image_size_source_ = images.begin()->second + ", the first image";
     }
-    const std::string name = p.filename().string().empty() ? p.parent_path().filename().string()
-                                                           : p.filename().string();
+    const std::string name =
+        p.filename().string().empty() ? p.parent_path().filename().string() : p.filename().string();
     const fs::path gt = p.parent_path().parent_path() / "poses" / (name + ".txt");
     if (FileExists(gt.string())) {
       const Trajectory all_gt = ReadTrajectory(gt.string(), TrajectoryFormat::kAuto);
@@ -140,6 +187,7 @@ class KittiOdometryDataset : public Dataset {
         selected.Append(frames_[i], all_gt.world_from_cam[*idx], timestamps_[i]);
       }
       ground_truth_ = selected;
+      ground_truth_files_ = {gt.string()};
     }
     id_ = "kitti:" + name + ":" + HashFiles(KeyFiles());
   }
@@ -148,7 +196,8 @@ class KittiOdometryDataset : public Dataset {
     return LoadScanChecked(ScanPath(frame), frame, dropped);
   }
   cv::Mat LoadImage(int64_t frame, int camera) const override {
-    return LoadImageChecked(ImagePath(frame, camera), frame, camera);
+    return LoadImageChecked(ImagePath(frame, camera), frame, camera, calibration_,
+                            image_size_source_);
   }
   std::string ScanPath(int64_t frame) const override {
     char name[32];
@@ -166,6 +215,16 @@ class KittiOdometryDataset : public Dataset {
 };
 
 }  // namespace
+
+std::vector<std::string> Dataset::InputFiles() const {
+  std::vector<std::string> files = KeyFiles();
+  files.insert(files.end(), ground_truth_files_.begin(), ground_truth_files_.end());
+  for (const int64_t f : frames_) {
+    files.push_back(ScanPath(f));
+    for (int camera = 0; camera < 4; ++camera) files.push_back(ImagePath(f, camera));
+  }
+  return files;
+}
 
 }  // namespace jvl::io
 #include "io/kitti_raw.h"

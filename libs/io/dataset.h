@@ -43,6 +43,9 @@ class Dataset {
   virtual std::string ImagePath(int64_t frame, int camera = 0) const = 0;
   // Key files that identify the content (calibration, times) for provenance.
   virtual std::vector<std::string> KeyFiles() const = 0;
+  // Every file the selected frames may be read from (key files, ground truth, the scans and the
+  // images of cameras 0-3), whether present or not: what a tool must never overwrite.
+  std::vector<std::string> InputFiles() const;
 
  protected:
   DatasetFormat format_ = DatasetFormat::kAuto;
@@ -51,6 +54,8 @@ class Dataset {
   std::vector<double> timestamps_;
   Calibration calibration_;
   std::optional<Trajectory> ground_truth_;
+  std::vector<std::string> ground_truth_files_;  // the files ground_truth_ was read from
+  std::string image_size_source_;  // where calibration_'s image size comes from
 };
 
 // Opens `dir` (format detected unless given) and selects the frames in `range`.
@@ -58,5 +63,22 @@ std::unique_ptr<Dataset> OpenDataset(const std::string& dir,
                                      DatasetFormat format = DatasetFormat::kAuto,
                                      const FrameRange& range = {});
 DatasetFormat DetectDatasetFormat(const std::string& dir);
+
+// The rules every dataset reader applies (KITTI odometry, KITTI raw):
+// - the frames of a sequence are every number from the first to the last file found among its
+//   scans and images; a frame whose file is missing is an error when a tool reads it;
+// - --frames must select at least one frame and may not end past the last one;
+// - a scan's non-finite points and points beyond kMaxScanRange are dropped with a warning, and
+//   an empty scan is warned about.
+std::vector<int64_t> DatasetFrames(const std::vector<int64_t>& scan_ids,
+                                   const std::vector<int64_t>& image_ids, const std::string& dir);
+void SelectFrames(const std::vector<int64_t>& all, const FrameRange& range, const std::string& dir,
+                  std::vector<int64_t>* selected);
+// - every image has the size of the sequence (calibration.image_width/height, taken from
+//   `size_source`), and at least kMinImageSide pixels a side.
+PointCloud LoadScanChecked(const std::string& path, int64_t frame, size_t* dropped);
+inline constexpr int kMinImageSide = 64;  // ORB's 31-pixel patches on a pyramid need room
+cv::Mat LoadImageChecked(const std::string& path, int64_t frame, int camera,
+                         const Calibration& calibration, const std::string& size_source);
 
 }  // namespace jvl::io

@@ -13,7 +13,8 @@
 
 namespace jvl::io {
 
-PointCloud ParseVelodyneBin(const std::string& bytes, const std::string& name, size_t* dropped) {
+PointCloud ParseVelodyneBin(const std::string& bytes, const std::string& name, size_t* dropped,
+                            size_t* out_of_range) {
   JVL_CHECK(bytes.size() % 16 == 0, name << ": size " << bytes.size()
                                          << " bytes is not a multiple of 16 (x, y, z, reflectance "
                                             "as float32): truncated or not a KITTI scan");
@@ -21,7 +22,8 @@ PointCloud ParseVelodyneBin(const std::string& bytes, const std::string& name, s
   PointCloud cloud;
   cloud.points.reserve(n);
   cloud.intensity.reserve(n);
-  size_t bad = 0;
+  size_t bad = 0, far = 0;
+  constexpr float kMaxRange2 = static_cast<float>(kMaxScanRange * kMaxScanRange);
   for (size_t i = 0; i < n; ++i) {
     float v[4];
     std::memcpy(v, bytes.data() + 16 * i, 16);
@@ -29,16 +31,25 @@ PointCloud ParseVelodyneBin(const std::string& bytes, const std::string& name, s
       ++bad;
       continue;
     }
+    // In double: a float square of 1e30 overflows to infinity (still "far", but say why).
+    const double r2 = static_cast<double>(v[0]) * v[0] + static_cast<double>(v[1]) * v[1] +
+                      static_cast<double>(v[2]) * v[2];
+    if (r2 > kMaxRange2) {
+      ++far;
+      continue;
+    }
     cloud.points.emplace_back(v[0], v[1], v[2]);
     cloud.intensity.push_back(std::isfinite(v[3]) ? v[3] : 0.0f);
   }
   if (dropped) *dropped = bad;
+  if (out_of_range) *out_of_range = far;
   return cloud;
 }
 
-PointCloud ReadVelodyneBin(const std::string& path, size_t* dropped) {
+PointCloud ReadVelodyneBin(const std::string& path, size_t* dropped, size_t* out_of_range) {
   JVL_CHECK(FileExists(path), path << ": scan file not found");
-  return ParseVelodyneBin(ReadTextFile(path), path, dropped);
+  JVL_CHECK(!IsDirectory(path), path << ": is a folder, not a scan file");
+  return ParseVelodyneBin(ReadTextFile(path), path, dropped, out_of_range);
 }
 
 void WriteVelodyneBin(const std::string& path, const PointCloud& cloud) {
@@ -134,6 +145,9 @@ std::vector<double> ParseKittiTimes(std::istream& in, const std::string& name) {
     if (body.empty()) continue;
     const auto v = ParseDouble(body);
     JVL_CHECK(v && std::isfinite(*v), name << ":" << line_no << ": bad timestamp '" << body << "'");
+    JVL_CHECK(times.empty() || *v > times.back(),
+              name << ":" << line_no << ": timestamp " << body << " does not increase (previous "
+                   << FormatDouble(times.back()) << ")");
     times.push_back(*v);
   }
   return times;

@@ -12,11 +12,17 @@
 
 namespace jvl::io {
 
+// Points farther than this from the sensor are not measurements (automotive LiDARs reach
+// 100-300 m; KITTI's HDL-64E 120 m): they are dropped and counted.
+inline constexpr double kMaxScanRange = 1000.0;
+
 // float32 x, y, z, reflectance per point. The file size must be a multiple of 16 bytes.
-// Non-finite points are dropped and counted in *dropped.
-PointCloud ReadVelodyneBin(const std::string& path, size_t* dropped = nullptr);
+// Non-finite points are dropped and counted in *dropped, points beyond kMaxScanRange in
+// *out_of_range.
+PointCloud ReadVelodyneBin(const std::string& path, size_t* dropped = nullptr,
+                           size_t* out_of_range = nullptr);
 PointCloud ParseVelodyneBin(const std::string& bytes, const std::string& name,
-                            size_t* dropped = nullptr);
+                            size_t* dropped = nullptr, size_t* out_of_range = nullptr);
 void WriteVelodyneBin(const std::string& path, const PointCloud& cloud);
 
 // calib.txt of the odometry benchmark: lines "P0: 12 numbers" ... "Tr: 12 numbers".

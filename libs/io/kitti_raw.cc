@@ -161,6 +161,7 @@ class KittiRawDataset : public Dataset {
               c2c << ": S_rect_00 is not an image size");
     calibration_.image_width = static_cast<int>(size[0]);
     calibration_.image_height = static_cast<int>(size[1]);
+    image_size_source_ = c2c + ", S_rect_00";
     const auto velo = ReadKeyValues(v2c);
     const Rigid3d cam0_from_velo_unrect =
         RigidFromRT(Require(velo, "R", 9, v2c), Require(velo, "T", 3, v2c), v2c);
@@ -168,14 +169,11 @@ class KittiRawDataset : public Dataset {
 
     scans_ = ListNumbered(drive / "velodyne_points" / "data", ".bin");
     const auto images = ListNumbered(drive / "image_00" / "data", ".png");
-    std::vector<int64_t> all;
-    for (const auto& [id, path] : scans_.empty() ? images : scans_) all.push_back(id);
-    JVL_CHECK(!all.empty(), dir << ": no frames found in velodyne_points/data or image_00/data");
-    for (int64_t f : all)
-      if (range.Contains(f)) frames_.push_back(f);
-    JVL_CHECK(!frames_.empty(), "--frames selects no frame of " << dir << " (frames "
-                                                                << all.front() << ".." << all.back()
-                                                                << ")");
+    std::vector<int64_t> scan_ids, image_ids;
+    for (const auto& entry : scans_) scan_ids.push_back(entry.first);
+    for (const auto& entry : images) image_ids.push_back(entry.first);
+    const std::vector<int64_t> all = DatasetFrames(scan_ids, image_ids, dir);
+    SelectFrames(all, range, dir, &frames_);
 
     // Timestamps of the LiDAR (or camera) stream, relative to the first line.
     const std::string stamps = (drive / (scans_.empty() ? "image_00" : "velodyne_points") /
@@ -203,6 +201,7 @@ class KittiRawDataset : public Dataset {
       for (const auto& [id, path] : oxts) {
         packets.push_back(ParseOxtsPacket(ReadTextFile(path), path));
         ids.push_back(id);
+        ground_truth_files_.push_back(path);
       }
       const auto imu0_from_imu = OxtsToImuPoses(packets);
       const auto imu = ReadKeyValues(i2v);
@@ -228,18 +227,11 @@ class KittiRawDataset : public Dataset {
   }
 
   PointCloud LoadScan(int64_t frame, size_t* dropped) const override {
-    const std::string path = ScanPath(frame);
-    JVL_CHECK(FileExists(path), path << ": missing scan for frame " << frame);
-    size_t bad = 0;
-    PointCloud cloud = ReadVelodyneBin(path, &bad);
-    if (bad > 0) spdlog::warn("{}: dropped {} non-finite points (frame {})", path, bad, frame);
-    if (dropped) *dropped = bad;
-    return cloud;
+    return LoadScanChecked(ScanPath(frame), frame, dropped);
   }
   cv::Mat LoadImage(int64_t frame, int camera) const override {
-    const std::string path = ImagePath(frame, camera);
-    JVL_CHECK(FileExists(path), path << ": missing image of camera " << camera << " for frame " << frame);
-    return ReadImage(path, camera < 2);
+    return LoadImageChecked(ImagePath(frame, camera), frame, camera, calibration_,
+                            image_size_source_);
   }
   std::string ScanPath(int64_t frame) const override {
     char name[32];

@@ -14,7 +14,7 @@ nlohmann::json LoadSchema(const std::string& path) {
   try {
     return nlohmann::json::parse(ReadTextFile(path));
   } catch (const nlohmann::json::exception& e) {
-    JVL_THROW(path << ": schema is not valid JSON: " << e.what());
+    JVL_THROW(path << ": schema is not valid JSON: " << JsonErrorText(e));
   }
 }
 

@@ -79,6 +79,15 @@ void VisualMapData::Check(const std::string& what) const {
     JVL_CHECK(keypoint_keyframe[observation_keypoint[i]] == observation_keyframe[i],
               what << ": observation " << i << " refers to a keypoint of another keyframe");
   }
+  for (size_t i = 0; i < 3 * m; ++i) {
+    JVL_CHECK(std::isfinite(mappoint_position[i]) && std::isfinite(mappoint_normal[i]),
+              what << ": map point " << i / 3 << " has a non-finite "
+                   << (std::isfinite(mappoint_position[i]) ? "normal" : "position"));
+  }
+  for (size_t i = 0; i < 2 * p; ++i) {
+    JVL_CHECK(std::isfinite(keypoint_uv[i]),
+              what << ": keypoint " << i / 2 << " has a non-finite position");
+  }
 }
 
 void WriteVisualMap(const std::string& path, const VisualMapData& d, const Provenance& provenance) {

@@ -1,6 +1,7 @@
 #include "lidar/preprocess.h"
 
 #include <pcl/ModelCoefficients.h>
+#include <pcl/console/print.h>
 #include <pcl/filters/radius_outlier_removal.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -20,7 +21,18 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// PCL prints its own diagnostics (e.g. "[pcl::SampleConsensusModelPlane::isSampleGood] ...")
+// to the terminal; the results it returns are checked here, so its text is kept out.
+void QuietPcl() {
+  static const bool quiet = [] {
+    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+    return true;
+  }();
+  (void)quiet;
+}
+
 pcl::PointCloud<pcl::PointXYZ>::Ptr ToPcl(const std::vector<Eigen::Vector3d>& points) {
+  QuietPcl();
   auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   cloud->resize(points.size());
   for (size_t i = 0; i < points.size(); ++i) {

@@ -14,7 +14,14 @@ namespace {
 
 const std::string kSource = std::string(JVL_SOURCE_DIR);
 
-bool HasType(const nlohmann::json& v, const std::string& type) {
+bool HasType(const nlohmann::json& v, const nlohmann::json& types) {
+  if (types.is_array()) {
+    for (const auto& t : types)
+      if (HasType(v, t)) return true;
+    return false;
+  }
+  const std::string type = types;
+  if (type == "null") return v.is_null();  // an undefined KITTI score
   if (type == "object") return v.is_object();
   if (type == "array") return v.is_array();
   if (type == "string") return v.is_string();

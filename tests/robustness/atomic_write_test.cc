@@ -1,15 +1,16 @@
 // Atomic writes under a kill signal: a process killed while it writes an artifact leaves the
-// previous artifact intact under the final name (and at most a "<name>.tmp.<pid>" file beside it).
+// previous artifact intact under the final name (and, after SIGKILL only, a "<name>.tmp.<pid>"
+// file beside it: SIGINT, SIGTERM and SIGHUP are caught and the temporary file removed).
 //
 // The library cases stop the writer in the middle of its write and kill it there; the tool cases
-// run the real command lines and kill them the moment their temporary file appears.
+// run the real command lines with pause_at_rename.c preloaded, which stops them at the rename of
+// a finished temporary file, and kill them there: every kill lands inside a write, with no race.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -74,19 +75,45 @@ TEST_F(AtomicWriteTest, KilledHdf5WriterLeavesThePreviousArtifact) {
   const std::string path = Path("odom.h5");
   io::WriteTrajectoryArtifact(path, Line(10), io::Provenance{});
   const std::string before = io::ReadTextFile(path);
-  for (int sig : {SIGKILL, SIGTERM, SIGINT}) {
+  // Without the tools' interrupt handler every signal leaves the temporary file; with it
+  // (io::InstallInterruptCleanup, as every tool runs) SIGTERM and SIGINT remove it.
+  for (const bool handler : {false, true}) {
+    for (int sig : {SIGKILL, SIGTERM, SIGINT}) {
+      const pid_t pid = KillInsideWrite(sig, [&](const std::function<void()>& stop) {
+        if (handler) io::InstallInterruptCleanup();
+        io::H5Writer w(path, "trajectory", 1);
+        w.WriteArray<double>("trajectory/poses", std::vector<double>(7 * 200000, 1.0),
+                             {200000, 7});
+        stop();  // Killed here: poses written to the temporary file, frames not yet.
+        w.WriteArray<int64_t>("trajectory/frames", std::vector<int64_t>(200000, 0));
+        w.Commit(io::Provenance{});
+      });
+      EXPECT_TRUE(io::ReadTextFile(path) == before) << "signal " << sig;
+      EXPECT_EQ(io::ReadTrajectory(path).size(), 10u);
+      const std::string tmp = path + ".tmp." + std::to_string(pid);
+      const bool removed = handler && sig != SIGKILL;
+      EXPECT_EQ(io::FileExists(tmp), !removed) << "signal " << sig << ", handler " << handler;
+      fs::remove(tmp);
+    }
+  }
+}
+
+TEST_F(AtomicWriteTest, InterruptedTextWriterRemovesItsTemporaryFile) {
+  const std::string path = Path("poses.txt");
+  io::WriteTrajectoryKitti(path, Line(10));
+  const std::string before = io::ReadTextFile(path);
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
     const pid_t pid = KillInsideWrite(sig, [&](const std::function<void()>& stop) {
-      io::H5Writer w(path, "trajectory", 1);
-      w.WriteArray<double>("trajectory/poses", std::vector<double>(7 * 200000, 1.0), {200000, 7});
-      stop();  // Killed here: poses written to the temporary file, frames not yet.
-      w.WriteArray<int64_t>("trajectory/frames", std::vector<int64_t>(200000, 0));
-      w.Commit(io::Provenance{});
+      io::InstallInterruptCleanup();
+      io::AtomicWrite(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp);
+        out << io::FormatTrajectoryKitti(Line(5), false);
+        out.flush();
+        stop();
+      });
     });
     EXPECT_TRUE(io::ReadTextFile(path) == before) << "signal " << sig;
-    EXPECT_EQ(io::ReadTrajectory(path).size(), 10u);
-    const std::string tmp = path + ".tmp." + std::to_string(pid);
-    EXPECT_TRUE(io::FileExists(tmp)) << "the interrupted write happened elsewhere";
-    fs::remove(tmp);
+    EXPECT_FALSE(io::FileExists(path + ".tmp." + std::to_string(pid))) << "signal " << sig;
   }
 }
 
@@ -107,12 +134,19 @@ TEST_F(AtomicWriteTest, KilledTextWriterLeavesThePreviousFile) {
   EXPECT_GT(io::FileSize(path + ".tmp." + std::to_string(pid)), 0);
 }
 
-// Runs argv in a child; kills it with `sig` as soon as one of `watched(pid)` exists. Returns
-// true if the kill happened while that file existed (the child was inside that write).
-bool RunAndKillWhenFileAppears(const std::vector<std::string>& argv, int sig,
-                               const std::function<std::vector<std::string>(pid_t)>& watched) {
+// Runs argv in a child with pause_at_rename preloaded: the child stops at the rename() of a
+// finished temporary file whose target contains `match` (any, if empty), with that temporary
+// file complete on disk, and is killed there with `sig`. Returns the child's pid if it was
+// killed at that point, -1 if it finished or failed before reaching it.
+pid_t RunAndKillAtRename(const std::vector<std::string>& argv, int sig, const std::string& match) {
+  int fds[2];
+  if (::pipe(fds) != 0) return -1;
   const pid_t pid = ::fork();
   if (pid == 0) {
+    ::close(fds[0]);
+    ::setenv("LD_PRELOAD", JVL_PAUSE_AT_RENAME, 1);
+    ::setenv("JVL_PAUSE_FD", std::to_string(fds[1]).c_str(), 1);
+    if (!match.empty()) ::setenv("JVL_PAUSE_MATCH", match.c_str(), 1);
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
@@ -120,24 +154,21 @@ bool RunAndKillWhenFileAppears(const std::vector<std::string>& argv, int sig,
     ::execv(args[0], args.data());
     ::_exit(127);
   }
-  const std::vector<std::string> paths = watched(pid);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  bool killed_inside = false;
+  ::close(fds[1]);
+  char byte = 0;
+  const bool paused = ::read(fds[0], &byte, 1) == 1;  // 0: the child ended without pausing
+  ::close(fds[0]);
+  if (paused) ::kill(pid, sig);
   int status = 0;
-  while (!killed_inside && std::chrono::steady_clock::now() < deadline) {
-    for (const std::string& path : paths) {
-      struct stat st;
-      if (::stat(path.c_str(), &st) == 0) {
-        ::kill(pid, sig);
-        killed_inside = true;
-        break;
-      }
-    }
-    if (!killed_inside && ::waitpid(pid, &status, WNOHANG) == pid) return false;  // Finished.
-  }
-  if (!killed_inside) ::kill(pid, SIGKILL);
   ::waitpid(pid, &status, 0);
-  return killed_inside && WIFSIGNALED(status);
+  return paused && WIFSIGNALED(status) && WTERMSIG(status) == sig ? pid : -1;
+}
+
+// Runs argv to the end; returns its exit status.
+int RunToEnd(const std::vector<std::string>& argv) {
+  std::string cmd;
+  for (const auto& a : argv) cmd += "'" + a + "' ";
+  return std::system((cmd + "> /dev/null 2>&1").c_str());
 }
 
 TEST_F(AtomicWriteTest, ToolKilledWhileWritingItsArtifactKeepsThePreviousOne) {
@@ -147,29 +178,19 @@ TEST_F(AtomicWriteTest, ToolKilledWhileWritingItsArtifactKeepsThePreviousOne) {
   const std::vector<std::string> argv = {
       kBin + "lidar_odom", "--dataset", seq, "--frames", "0:8", "-o", out,
       "--quiet",           "--threads", "1"};
-  ASSERT_FALSE(
-      RunAndKillWhenFileAppears(argv, SIGKILL, [](pid_t) { return std::vector<std::string>{}; }));
+  ASSERT_EQ(RunToEnd(argv), 0);
   ASSERT_EQ(io::ReadTrajectory(out).size(), 8u);
-  // The kill comes while the temporary file exists; on a busy machine the write can also finish
-  // first, then the new complete artifact is the previous one of the next attempt.
-  int inside = 0;
-  for (int attempt = 0; attempt < 12 && inside < 2; ++attempt) {
-    const std::string before = io::ReadTextFile(out);
-    const int sig = attempt % 2 == 0 ? SIGKILL : SIGTERM;
-    pid_t child = 0;
-    const bool killed = RunAndKillWhenFileAppears(argv, sig, [&](pid_t pid) {
-      child = pid;
-      return std::vector<std::string>{out + ".tmp." + std::to_string(pid)};
-    });
-    if (killed) {
-      ++inside;
-      EXPECT_TRUE(io::ReadTextFile(out) == before) << "attempt " << attempt << ": artifact changed";
-    }
-    EXPECT_EQ(io::ReadTrajectory(out).size(), 8u) << "attempt " << attempt;
-    fs::remove(out + ".tmp." + std::to_string(child));
+  const std::string before = io::ReadTextFile(out);
+  for (const int sig : {SIGKILL, SIGTERM, SIGINT}) {
+    const pid_t pid = RunAndKillAtRename(argv, sig, "odom.h5");
+    ASSERT_GT(pid, 0) << "signal " << sig << ": the run did not reach its rename";
+    EXPECT_TRUE(io::ReadTextFile(out) == before) << "signal " << sig << ": artifact changed";
+    EXPECT_EQ(io::ReadTrajectory(out).size(), 8u) << "signal " << sig;
+    // SIGTERM and SIGINT are caught: the tool removes its temporary file before it ends.
+    const std::string tmp = out + ".tmp." + std::to_string(pid);
+    EXPECT_EQ(io::FileExists(tmp), sig == SIGKILL) << "signal " << sig;
+    fs::remove(tmp);
   }
-  RecordProperty("killed_while_writing", inside);
-  EXPECT_GE(inside, 1) << "no run was killed while its artifact was being written";
 }
 
 TEST_F(AtomicWriteTest, SimSequenceKilledMidRunLeavesOnlyCompleteFiles) {
@@ -178,37 +199,29 @@ TEST_F(AtomicWriteTest, SimSequenceKilledMidRunLeavesOnlyCompleteFiles) {
     return std::vector<std::string>{kBin + "sim_sequence", "-o", root, "--frames", "8", "--quiet",
                                     "--threads",           "1"};
   };
-  auto never = [](pid_t) { return std::vector<std::string>{}; };
-  ASSERT_FALSE(RunAndKillWhenFileAppears(argv(ref), SIGKILL, never));
-  ASSERT_FALSE(RunAndKillWhenFileAppears(argv(out), SIGKILL, never));
-  // Reruns over the finished output, killed while one of the scans is being written.
-  int inside = 0;
-  for (int attempt = 0; attempt < 3 && inside < 1; ++attempt) {
-    const bool killed = RunAndKillWhenFileAppears(argv(out), SIGKILL, [&](pid_t pid) {
-      std::vector<std::string> tmp;
-      for (int f = 1; f < 8; ++f) {
-        char name[64];
-        std::snprintf(name, sizeof(name), "/sequences/00/velodyne/%06d.bin.tmp.%d", f, pid);
-        tmp.push_back(out + name);
-      }
-      return tmp;
-    });
-    inside += killed ? 1 : 0;
+  ASSERT_EQ(RunToEnd(argv(ref)), 0);
+  ASSERT_EQ(RunToEnd(argv(out)), 0);
+  // Reruns over the finished output, killed at the rename of scan 3 (its new version complete in
+  // the temporary file), by a signal the tool cannot catch and by one it does.
+  for (const int sig : {SIGKILL, SIGTERM}) {
+    const pid_t pid = RunAndKillAtRename(argv(out), sig, "velodyne/000003.bin");
+    ASSERT_GT(pid, 0) << "signal " << sig << ": the run did not reach the rename of scan 3";
+    int temporary = 0;
     for (const auto& e : fs::recursive_directory_iterator(out)) {
       if (!e.is_regular_file()) continue;
       const std::string rel = fs::relative(e.path(), out).string();
       if (rel.find(".tmp.") != std::string::npos) {
-        EXPECT_TRUE(killed) << rel << " left by a run that was not killed";
+        ++temporary;
         fs::remove(e.path());
         continue;
       }
       if (rel.find("/sim/") != std::string::npos) continue;  // JSON: provenance times differ.
       // sim_sequence is deterministic: every file under a final name is the complete reference.
-      EXPECT_TRUE(io::ReadTextFile(e.path().string()) == io::ReadTextFile(ref + "/" + rel)) << rel;
+      EXPECT_TRUE(io::ReadTextFile(e.path().string()) == io::ReadTextFile(ref + "/" + rel))
+          << rel << ", signal " << sig;
     }
+    EXPECT_EQ(temporary, sig == SIGKILL ? 1 : 0) << "signal " << sig;
   }
-  RecordProperty("killed_while_writing", inside);
-  EXPECT_GE(inside, 1) << "no run was killed while a scan was being written";
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 // Inputs: the chain of run_a (robust_pipeline_a, 40 synthetic frames) and copies of its
 // sequence with one thing broken each, under <build>/tests/robustness/bad.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -14,11 +15,15 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "io/artifact.h"
 #include "io/directions_io.h"
 #include "io/files.h"
+#include "io/kitti.h"
 #include "io/local_io.h"
 #include "io/trajectory_io.h"
 #include "io/visual_io.h"
@@ -34,13 +39,45 @@ const std::string kRun = std::string(JVL_BINARY_DIR) + "/tests/robustness/run_a"
 const std::string kBad = std::string(JVL_BINARY_DIR) + "/tests/robustness/bad";
 const std::string kSeq = kRun + "/data/sequences/00";
 
+std::string In(const std::string& name) { return kRun + "/" + name; }
+std::string Bad(const std::string& name) { return kBad + "/" + name; }
+
 struct Outcome {
   int code = 0;
   std::string err;
 };
 
+// What must not change when a tool runs: every file named on its command line (by content) and
+// every file under a folder named there (by size and modification time: datasets hold tens of
+// MB). Outputs that the run is allowed to write are left out by the caller.
+std::map<std::string, std::string> Snapshot(const std::string& args,
+                                            const std::vector<std::string>& may_change) {
+  std::map<std::string, std::string> snap;
+  std::istringstream in(args);
+  std::string token;
+  const auto allowed = [&](const std::string& path) {
+    for (const std::string& m : may_change)
+      if (io::SameFile(m, path)) return true;
+    return false;
+  };
+  while (in >> token) {
+    std::error_code ec;
+    if (fs::is_regular_file(token, ec)) {
+      if (!allowed(token)) snap[token] = io::DescribeFile(token).hash;
+    } else if (fs::is_directory(token, ec)) {
+      for (const auto& e : fs::recursive_directory_iterator(token, ec)) {
+        if (!e.is_regular_file() || allowed(e.path().string())) continue;
+        const auto time = fs::last_write_time(e.path(), ec).time_since_epoch().count();
+        snap[e.path().string()] =
+            std::to_string(fs::file_size(e.path(), ec)) + "@" + std::to_string(time);
+      }
+    }
+  }
+  return snap;
+}
+
 Outcome Run(const std::string& tool, const std::string& args) {
-  const std::string err_path = kBad + "/stderr.txt";
+  const std::string err_path = kBad + ".stderr.txt";  // beside kBad: not part of a snapshot
   const std::string log = args.find("--log-level") == std::string::npos ? " --log-level warn" : "";
   const std::string cmd = "timeout -k 5 120 " + kBin + tool + " " + args + " --quiet" + log +
                           " > /dev/null 2> " + err_path;
@@ -60,8 +97,10 @@ std::vector<std::string> Lines(const std::string& text) {
   return lines;
 }
 
-// Fails with exit code 1/2 and one error line that contains `expected`.
+// Fails with exit code 1/2 and one error line that contains `expected`; no file named on the
+// command line (or under a folder named there) changes.
 void ExpectError(const std::string& tool, const std::string& args, const std::string& expected) {
+  const auto before = Snapshot(args, {});
   const Outcome o = Run(tool, args);
   const std::string what = tool + " " + args + "\nexit code " + std::to_string(o.code) +
                            (o.code == 124  ? " (hang)"
@@ -72,6 +111,7 @@ void ExpectError(const std::string& tool, const std::string& args, const std::st
   std::vector<std::string> other;  // Lines that are not log lines ("[time] [level] ...").
   for (const std::string& line : Lines(o.err))
     if (line.front() != '[') other.push_back(line);
+  EXPECT_TRUE(Snapshot(args, {}) == before) << "a file changed:\n" << what;
   ASSERT_EQ(other.size(), 1u) << what;
   std::printf("[error]   %s\n", other[0].c_str());  // The matrix, for docs/robustness.md.
   EXPECT_EQ(other[0].rfind(tool + ": error: ", 0), 0u) << what;
@@ -79,12 +119,16 @@ void ExpectError(const std::string& tool, const std::string& args, const std::st
                                                         << what;
 }
 
-// A documented fallback: exit code 0 and a warning that contains `expected`.
-void ExpectWarning(const std::string& tool, const std::string& args, const std::string& expected) {
+// A documented fallback: exit code 0 and a warning that contains `expected`; every line on
+// stderr is a log line, and no input changes (`outputs` may).
+void ExpectWarning(const std::string& tool, const std::string& args, const std::string& expected,
+                   const std::vector<std::string>& outputs = {Bad("x.h5")}) {
+  const auto before = Snapshot(args, outputs);
   const Outcome o = Run(tool, args);
   const std::string what =
       tool + " " + args + "\nexit code " + std::to_string(o.code) + "\nstderr:\n" + o.err;
   EXPECT_EQ(o.code, 0) << what;
+  EXPECT_TRUE(Snapshot(args, outputs) == before) << "an input changed:\n" << what;
   bool found = false;
   for (const std::string& line : Lines(o.err)) {
     EXPECT_EQ(line.front(), '[') << "not a log line: " << line << "\n" << what;
@@ -94,6 +138,15 @@ void ExpectWarning(const std::string& tool, const std::string& args, const std::
     }
   }
   EXPECT_TRUE(found) << "expected a warning with '" << expected << "' in\n" << what;
+}
+
+// Exit code 0, nothing but log lines on stderr, and no warning or error among them.
+void ExpectQuiet(const std::string& tool, const std::string& args) {
+  const Outcome o = Run(tool, args);
+  const std::string what =
+      tool + " " + args + "\nexit code " + std::to_string(o.code) + "\nstderr:\n" + o.err;
+  EXPECT_EQ(o.code, 0) << what;
+  EXPECT_TRUE(Lines(o.err).empty()) << what;
 }
 
 void WriteFile(const std::string& path, const std::string& content) {
@@ -134,9 +187,6 @@ std::string Image(const std::string& seq, int frame) {
   std::snprintf(file, sizeof(file), "/image_0/%06d.png", frame);
   return seq + file;
 }
-
-std::string In(const std::string& name) { return kRun + "/" + name; }
-std::string Bad(const std::string& name) { return kBad + "/" + name; }
 
 io::Provenance WithDataset(const std::string& id) {
   io::Provenance p;
@@ -433,7 +483,7 @@ TEST_F(BadInputTest, EmptyContent) {
   ExpectWarning("direction_cluster",
                 "--vps " + Bad("vps_none.h5") + " --prior " + In("prior.h5") + " -o " +
                     Bad("directions_none.h5"),
-                "no direction prior");
+                "no direction prior", {Bad("directions_none.h5")});
   ExpectWarning("global_opt",
                 "--local " + Bad("local8.h5") + " --visual " + Bad("visual8.h5") +
                     " --directions " + Bad("directions_none.h5") + " -o " + Bad("x.h5"),
@@ -481,7 +531,7 @@ TEST_F(BadInputTest, EmptyContent) {
   ExpectWarning(
       "local_map",
       "--visual " + Bad("visual_split.h5") + " --dataset " + kSeq + " -o " + Bad("local_split.h5"),
-      "covisibility graph");
+      "covisibility graph", {Bad("local_split.h5")});
   ExpectWarning("global_opt",
                 "--local " + Bad("local8.h5") + " --visual " + Bad("visual_split.h5") +
                     " --directions " + In("directions.h5") + " -o " + Bad("x.h5"),
@@ -532,7 +582,281 @@ TEST_F(BadInputTest, InvalidOptions) {
   ExpectError("evaluate", "--gt " + In("prior.h5") + " --est " + In("odom.h5") + " --rpe-delta 0",
               "--rpe-delta");
   // An output that cannot be written: the message names it.
-  ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + kBad, "bad: cannot move");
+  ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + kBad, "bad: is a folder");
+}
+
+// ---------------------------------------------------------------------------------------------
+// An output that is one of the inputs (by path, "./", symbolic link or hard link, or a file of
+// the dataset) is refused before any work, naming both; two outputs on one path likewise.
+
+void CopyTo(const std::string& from, const std::string& to) {
+  fs::remove(to);
+  fs::copy_file(from, to);
+}
+
+TEST_F(BadInputTest, OutputThatIsAnInputIsRefused) {
+  const std::string seq = Sequence("out_in", 8);
+  const std::string same = "is the same file as input";
+  for (const std::string a : {"prior.h5", "vps.h5", "directions.h5", "visual.h5", "local.h5"})
+    CopyTo(In(a), Bad("own_" + a));
+  CopyTo(kRun + "/data/poses/00.txt", Bad("own_gt.txt"));
+  CopyTo(In("odom.txt"), Bad("own_odom.txt"));
+  const std::string vps = Bad("own_vps.h5"), prior = Bad("own_prior.h5");
+  const std::string dirs = Bad("own_directions.h5"), visual = Bad("own_visual.h5");
+  const std::string local = Bad("own_local.h5"), gt = Bad("own_gt.txt");
+  fs::remove(Bad("vps_hardlink.h5"));
+  fs::create_hard_link(vps, Bad("vps_hardlink.h5"));
+  fs::remove(Bad("prior_symlink.h5"));
+  fs::create_symlink(prior, Bad("prior_symlink.h5"));
+
+  ExpectError("lidar_odom", "--dataset " + seq + " -o " + seq + "/calib.txt",
+              "output --output " + seq + "/calib.txt is the same file as input");
+  ExpectError("lidar_odom",
+              "--dataset " + seq + " -o " + Bad("x.h5") + " --kitti-poses " + Bad("./x.h5"),
+              "are the same file");
+  ExpectError("vp_detect",
+              "--dataset " + seq + " -o " + Bad("x.h5") + " --csv " + seq + "/times.txt", same);
+  // A symbolic link into run_a's images: the image itself must stay.
+  ExpectError("vp_detect", "--dataset " + seq + " -o " + Image(seq, 2), same);
+  ExpectError("direction_cluster",
+              "--vps " + vps + " --prior " + prior + " -o " + Bad("vps_hardlink.h5"), same);
+  ExpectError("direction_cluster",
+              "--vps " + vps + " --prior " + gt + " -o " + Bad("x.h5") + " --csv " + gt, same);
+  ExpectError("direction_cluster",
+              "--vps " + vps + " --prior " + prior + " -o " + Bad("x.h5") + " --plot " +
+                  Bad("prior_symlink.h5"),
+              same);
+  ExpectError("visual_assoc",
+              "--dataset " + seq + " --prior " + prior + " -o " + kBad + "/./own_prior.h5", same);
+  ExpectError("visual_assoc", "--dataset " + seq + " --prior " + prior + " -o " + Scan(seq, 3),
+              same);
+  ExpectError("local_map",
+              "--visual " + visual + " --dataset " + seq + " -o " + Bad("x.h5") +
+                  " --kitti-poses " + Scan(seq, 3),
+              same);
+  const std::string global = "--local " + local + " --visual " + visual + " --directions " + dirs;
+  ExpectError("global_opt", global + " -o " + local, same);
+  ExpectError("global_opt", global + " -o " + Bad("x.h5") + " --map " + visual, same);
+  ExpectError("global_opt", global + " -o " + Bad("x.h5") + " --kitti-poses " + dirs, same);
+  ExpectError("global_opt", global + " -o " + Bad("x.h5") + " --map " + Bad("x.h5"),
+              "are the same file");
+  ExpectError("make_prior", "-g " + gt + " -o " + gt, same);
+  ExpectError("evaluate", "--gt " + gt + " --est " + prior + " --json " + gt, same);
+  ExpectError("evaluate",
+              "--gt " + gt + " --est " + Bad("own_odom.txt") + " --markdown " + Bad("own_odom.txt"),
+              same);
+  ExpectError("sim_map_check", "--sequence " + kSeq + " --visual " + visual + " --json " + visual,
+              same);
+  ExpectError("sim_map_check",
+              "--sequence " + kSeq + " --visual " + visual + " --points-csv " + kSeq + "/calib.txt",
+              same);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Inputs that were once read silently wrong.
+
+// Sets element `index` of a float64 dataset of an HDF5 file in place.
+void PatchDouble(const std::string& path, const std::string& dataset, size_t index, double value) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(file, 0) << path;
+  const hid_t d = H5Dopen2(file, dataset.c_str(), H5P_DEFAULT);
+  ASSERT_GE(d, 0) << path << ":" << dataset;
+  const hid_t space = H5Dget_space(d);
+  std::vector<double> v(static_cast<size_t>(H5Sget_simple_extent_npoints(space)));
+  ASSERT_GE(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0);
+  ASSERT_LT(index, v.size());
+  v[index] = value;
+  ASSERT_GE(H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), 0);
+  H5Sclose(space);
+  H5Dclose(d);
+  H5Fclose(file);
+}
+
+TEST_F(BadInputTest, ConfigFileWithAnUnknownKey) {
+  WriteFile(Bad("typo.ini"), "no-such-key = 3\n");
+  ExpectError("lidar_odom",
+              "--dataset " + kSeq + " -o " + Bad("x.h5") + " --config " + Bad("typo.ini"),
+              "typo.ini: INI was not able to parse no-such-key");
+  ExpectError("evaluate",
+              "--gt " + In("prior.h5") + " --est " + In("odom.h5") + " --config " + Bad("typo.ini"),
+              "typo.ini: INI was not able to parse");
+}
+
+TEST_F(BadInputTest, TimesAndFrameRanges) {
+  const std::string back = Sequence("times_back", 4);
+  WriteFile(back + "/times.txt", "0.0\n0.2\n0.1\n0.3\n");
+  ExpectError("dataset_info", "-d " + back, "times.txt:3: timestamp 0.1 does not increase");
+  ExpectError("lidar_odom", "--dataset " + back + " -o " + Bad("x.h5"), "does not increase");
+  for (const std::string tool : {"lidar_odom", "vp_detect"}) {
+    ExpectError(tool, "--dataset " + kSeq + " --frames 0:9999 -o " + Bad("x.h5"),
+                "--frames 0:9999 goes past the last frame");
+    ExpectError(tool, "--dataset " + kSeq + " --frames 30:20 -o " + Bad("x.h5"),
+                "--frames: end must be an integer > start");
+  }
+  ExpectError(
+      "visual_assoc",
+      "--dataset " + kSeq + " --frames 0:9999 --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+      "goes past the last frame");
+  ExpectError("dataset_info", "-d " + kSeq + " --frames 10:41", "goes past the last frame");
+}
+
+TEST_F(BadInputTest, TrajectoryArtifactsAndTumText) {
+  {
+    io::H5Writer w(Bad("traj_v2.h5"), "trajectory", 2);
+    io::WriteTrajectoryGroup(w, "trajectory", io::ReadTrajectory(In("prior.h5")));
+    w.Commit(WithDataset(id_));
+  }
+  ExpectError("evaluate", "--gt " + kRun + "/data/poses/00.txt --est " + Bad("traj_v2.h5"),
+              "traj_v2.h5: expected schema 'trajectory' version 1, found 'trajectory' version 2");
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --prior " + Bad("traj_v2.h5") + " -o " + Bad("x.h5"),
+              "found 'trajectory' version 2");
+  // Poses are [qx qy qz qw tx ty tz]: qx of frame 3.
+  CopyTo(In("prior.h5"), Bad("prior_q.h5"));
+  PatchDouble(Bad("prior_q.h5"), "trajectory/poses", 7 * 3, 0.6);
+  ExpectError("make_prior", "-g " + Bad("prior_q.h5") + " -o " + Bad("x.h5"),
+              "prior_q.h5: trajectory frame 3: quaternion is not unit");
+  ExpectError("direction_cluster",
+              "--vps " + In("vps.h5") + " --prior " + Bad("prior_q.h5") + " -o " + Bad("x.h5"),
+              "quaternion is not unit");
+  // Off by text rounding (1e-4 here): normalised, with one warning for the file.
+  CopyTo(In("prior.h5"), Bad("prior_q4.h5"));
+  {
+    Trajectory t = io::ReadTrajectory(In("prior.h5"));
+    const auto a = t.world_from_cam[3].ToArray();
+    PatchDouble(Bad("prior_q4.h5"), "trajectory/poses", 7 * 3 + 3, a[3] * (1 + 1e-4));
+  }
+  ExpectWarning("make_prior", "-g " + Bad("prior_q4.h5") + " -o " + Bad("x.h5"),
+                "1 rotation(s) not unit");
+  WriteFile(Bad("tum_back.txt"), "0.0 0 0 0 0 0 0 1\n0.2 0 0 1 0 0 0 1\n0.1 0 0 2 0 0 0 1\n");
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --prior " + Bad("tum_back.txt") + " -o " + Bad("x.h5"),
+              "tum_back.txt:3: timestamp 0.1 does not increase");
+}
+
+TEST_F(BadInputTest, ScansThatAreMissingEmptyOrAbsurd) {
+  const std::string gap = Sequence("gap_bin", 8);
+  fs::remove(Scan(gap, 3));
+  ExpectError("lidar_odom", "--dataset " + gap + " -o " + Bad("x.h5"),
+              "000003.bin: missing scan for frame 3");
+  fs::remove_all(gap + "/image_0");  // a LiDAR-only sequence: the rule is the same
+  ExpectError("lidar_odom", "--dataset " + gap + " -o " + Bad("x.h5"),
+              "000003.bin: missing scan for frame 3");
+
+  const std::string folder = Sequence("folder_bin", 8);
+  fs::remove(Scan(folder, 2));
+  fs::create_directory(Scan(folder, 2));
+  ExpectError("lidar_odom", "--dataset " + folder + " -o " + Bad("x.h5"),
+              "000002.bin: is a folder, not a scan file");
+
+  // local_map on the 8-keyframe visual map, reading the scans of `dir`.
+  const auto local_map_on = [&](const std::string& dir) {
+    return "--visual " + Bad("visual8.h5") + " --dataset " + dir + " -o " + Bad("x.h5");
+  };
+  const std::string zeros = Sequence("zero_bin", 40);
+  WriteFile(Scan(zeros, 2), std::string(16 * 1000, '\0'));
+  ExpectWarning("local_map", local_map_on(zeros), "only 0 of 1000 points have a surface normal");
+  const std::string tiny = Sequence("tiny_bin", 40);
+  WriteFile(Scan(tiny, 2), Head(Scan(kSeq, 2), 16 * 10));
+  ExpectWarning("local_map", local_map_on(tiny), "of 10 points have a surface normal");
+
+  // Points at 1e30 m: dropped with a count; no library text on the terminal.
+  const std::string far = Sequence("far_bin", 40);
+  std::string bytes = io::ReadTextFile(Scan(kSeq, 2));
+  const float huge = 1e30f;
+  size_t count = 0;
+  for (size_t i = 0; i + 16 <= bytes.size(); i += 16 * 3, ++count)
+    for (int k = 0; k < 3; ++k) std::memcpy(&bytes[i + 4 * k], &huge, 4);
+  WriteFile(Scan(far, 2), bytes);
+  ExpectWarning("lidar_odom", "--dataset " + far + " --frames 0:5 -o " + Bad("x.h5"),
+                "000002.bin: dropped " + std::to_string(count) + " points farther than 1000 m");
+  ExpectWarning("local_map", local_map_on(far), "points farther than 1000 m");
+}
+
+TEST_F(BadInputTest, ImagesOfAnotherSize) {
+  const cv::Mat image = io::ReadImage(Image(kSeq, 3), true);
+  cv::Mat smaller;
+  cv::resize(image, smaller, cv::Size(image.cols / 2, image.rows / 2));
+  // One thread: the images are read in order, so the first bad one is the one named.
+  const std::string visual = " --prior " + In("prior.h5") + " -o " + Bad("x.h5") + " --threads 1";
+  const std::string third = Sequence("size_3", 6);
+  fs::remove(Image(third, 3));
+  io::WriteImage(Image(third, 3), smaller);
+  ExpectError("visual_assoc", "--dataset " + third + visual,
+              "000003.png: image is " + std::to_string(smaller.cols) + "x" +
+                  std::to_string(smaller.rows) + " but the sequence's are " +
+                  std::to_string(image.cols) + "x" + std::to_string(image.rows));
+  ExpectError("vp_detect", "--dataset " + third + " -o " + Bad("x.h5") + " --threads 1",
+              "000003.png: image is");
+  const std::string first = Sequence("size_0", 6);
+  fs::remove(Image(first, 0));
+  io::WriteImage(Image(first, 0), smaller);
+  ExpectError("visual_assoc", "--dataset " + first + visual,
+              "000001.png: image is " + std::to_string(image.cols) + "x" +
+                  std::to_string(image.rows) + " but the sequence's are");
+  const std::string dot = Sequence("size_1x1", 6);
+  fs::remove(Image(dot, 0));
+  io::WriteImage(Image(dot, 0), cv::Mat(1, 1, CV_8UC1, cv::Scalar(7)));
+  ExpectError("visual_assoc", "--dataset " + dot + visual, "000000.png: image is 1x1, too small");
+}
+
+TEST_F(BadInputTest, ArtifactContentAndOptions) {
+  CopyTo(In("visual.h5"), Bad("visual_nan.h5"));
+  PatchDouble(Bad("visual_nan.h5"), "mappoints/position", 3 * 5 + 1,
+              std::numeric_limits<double>::quiet_NaN());
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + Bad("visual_nan.h5") + " --directions " +
+                  In("directions.h5") + " -o " + Bad("x.h5"),
+              "visual_nan.h5: map point 5 has a non-finite position");
+  ExpectError("local_map",
+              "--visual " + Bad("visual_nan.h5") + " --dataset " + kSeq + " -o " + Bad("x.h5"),
+              "map point 5 has a non-finite position");
+  // --dataset of another sequence than the VPs'.
+  const std::string other = Sequence("other_seq", 8, "07");
+  ExpectError("direction_cluster",
+              "--vps " + In("vps.h5") + " --prior " + In("prior.h5") + " --dataset " + other +
+                  " -o " + Bad("x.h5"),
+              "(inputs of different sequences)");
+  ExpectError("vp_detect", "--dataset " + kSeq + " -o " + Bad("x.h5") + " --seed -1", "--seed");
+  ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + Bad("x.h5") + " --seed -3", "--seed");
+  // A broken scene description: the message is ours, not the JSON library's.
+  const std::string scene = Sequence("scene_json", 40);
+  fs::create_directories(scene + "/sim");
+  WriteFile(scene + "/sim/scene.json", "{\"schema\": \"sim_scene\", ");
+  ExpectError("sim_map_check", "--sequence " + scene + " --visual " + In("visual.h5"),
+              "scene.json: not valid JSON (truncated?): parse error at line 1");
+  const Outcome o =
+      jvl::Run("sim_map_check", "--sequence " + scene + " --visual " + In("visual.h5"));
+  EXPECT_EQ(o.err.find("json.exception"), std::string::npos) << o.err;
+  // More threads than the machine has: capped with one warning, no solver library text.
+  ExpectWarning("global_opt",
+                "--local " + Bad("local8.h5") + " --visual " + Bad("visual8.h5") +
+                    " --directions " + In("directions.h5") + " -o " + Bad("x.h5") +
+                    " --threads 10000",
+                "hardware threads; using");
+}
+
+TEST_F(BadInputTest, EvaluateOnAShortDriveAndItsPlots) {
+  // run_a's drive is about 40 m: no KITTI segment of 100 m, so t_rel and r_rel are undefined.
+  ExpectQuiet("evaluate", "--gt " + kRun + "/data/poses/00.txt --est " + In("prior.h5") +
+                              " --json " + Bad("short.json") + " --markdown " + Bad("short.md") +
+                              " --plot-dir " + Bad("short_plots"));
+  const auto report = nlohmann::json::parse(io::ReadTextFile(Bad("short.json")));
+  const auto& kitti = report["estimates"][0]["kitti"];
+  EXPECT_EQ(kitti["segments"], 0);
+  EXPECT_TRUE(kitti["t_rel_percent"].is_null()) << kitti.dump();
+  EXPECT_TRUE(kitti["r_rel_deg_per_100m"].is_null()) << kitti.dump();
+  const std::string md = io::ReadTextFile(Bad("short.md"));
+  EXPECT_NE(md.find("| n/a | n/a | 0 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("are n/a: its path is shorter than the shortest KITTI segment"),
+            std::string::npos)
+      << md;
+  EXPECT_TRUE(io::FileExists(Bad("short_plots/kitti_per_length.png")));
+  ExpectError("evaluate",
+              "--gt " + kRun + "/data/poses/00.txt --est " + In("prior.h5") + " --plot-dir " +
+                  Bad("plots_x") + " --python /nonexistent/python3",
+              "--python /nonexistent/python3: not a Python interpreter with matplotlib");
+  EXPECT_FALSE(io::FileExists(Bad("plots_x")));
 }
 
 }  // namespace

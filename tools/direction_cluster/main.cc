@@ -75,13 +75,19 @@ int main(int argc, char** argv) {
   std::string vps_path, prior_path, dataset, output, csv, plot, up = "auto";
   direction::DirectionClusterOptions o;
   auto& cli = tool.cli();
-  cli.add_option("--vps", vps_path, "vps artifact (vp_detect)")->required();
-  cli.add_option("--prior", prior_path, "Prior trajectory (.h5 artifact, KITTI or TUM text)")
-      ->required();
-  cli.add_option("-d,--dataset", dataset, "Dataset folder for the intrinsics if vps has no camera");
-  cli.add_option("-o,--output", output, "directions artifact to write")->required();
-  cli.add_option("--csv", csv, "CSV of the associations: frame,cluster,u,v,dwx,dwy,dwz");
-  cli.add_option("--plot", plot, "Top-view PNG of the trajectory and the clusters");
+  tool.InputFile(cli.add_option("--vps", vps_path, "vps artifact (vp_detect)")->required());
+  tool.InputFile(
+      cli.add_option("--prior", prior_path, "Prior trajectory (.h5 artifact, KITTI or TUM text)")
+          ->required());
+  cli.add_option("-d,--dataset", dataset,
+                 "Dataset folder: the intrinsics if vps has no camera; must be the sequence the "
+                 "VPs were detected on");
+  tool.OutputFile(
+      cli.add_option("-o,--output", output, "directions artifact to write")->required());
+  tool.OutputFile(
+      cli.add_option("--csv", csv, "CSV of the associations: frame,cluster,u,v,dwx,dwy,dwz"));
+  tool.OutputFile(
+      cli.add_option("--plot", plot, "Top-view PNG of the trajectory and the clusters"));
   cli.add_option("--v-interval", o.v_interval,
                  "V_interval: keep associations of a cluster >= K frames apart (0 = all)")
       ->capture_default_str();
@@ -127,18 +133,21 @@ int main(int argc, char** argv) {
   return tool.Run(argc, argv, [&] {
     o.up = ParseUp(up);
     o.Check();
-    const io::VpsData vps = io::ReadVpsArtifact(vps_path);
     tool.AddInput(vps_path);
-    const Trajectory prior = io::ReadTrajectory(prior_path);
     tool.AddInput(prior_path);
+    std::unique_ptr<io::Dataset> ds;
+    if (!dataset.empty()) {
+      ds = io::OpenDataset(dataset);
+      tool.AddDataset(*ds, dataset);  // refuses a dataset of another sequence than the VPs'
+    }
+    const io::VpsData vps = io::ReadVpsArtifact(vps_path);
+    const Trajectory prior = io::ReadTrajectory(prior_path);
     PinholeCamera camera;
     if (vps.camera.fx > 0) {
       camera = vps.camera;
     } else {
-      JVL_CHECK(!dataset.empty(), vps_path << " has no camera; pass --dataset for the intrinsics");
-      const auto ds = io::OpenDataset(dataset);
+      JVL_CHECK(ds, vps_path << " has no camera; pass --dataset for the intrinsics");
       camera = ds->calibration().Camera(0);
-      tool.SetDatasetId(ds->id(), dataset);
     }
     const auto result = direction::ClusterDirections(ToObservations(vps), prior, camera, o);
     if (result.stats.missing_prior > 0)

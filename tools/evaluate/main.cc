@@ -19,9 +19,12 @@ int main(int argc, char** argv) {
   std::string align = "none", assoc = "frame", rpe_unit = "frames";
   std::string json, markdown, plot_dir, plot_script, python;
   CLI::App& cli = tool.cli();
-  cli.add_option("--gt", c.gt, "Ground truth: trajectory file (KITTI/TUM/.h5) or folder of them")
-      ->required();
-  cli.add_option("--est", c.est, "Estimate(s): file, or folder when --gt is a folder")->required();
+  tool.InputFile(cli.add_option("--gt", c.gt,
+                                "Ground truth: trajectory file (KITTI/TUM/.h5) or folder of them")
+                     ->required());
+  tool.InputFile(
+      cli.add_option("--est", c.est, "Estimate(s): file, or folder when --gt is a folder")
+          ->required());
   cli.add_option("--label", c.labels, "Name of each estimate in the reports (one per --est)");
   cli.add_option("--align", align, "none | origin | se3 | sim3")->capture_default_str();
   cli.add_flag("--origin-first", c.options.origin_first,
@@ -40,8 +43,9 @@ int main(int argc, char** argv) {
   cli.add_option("--lidar-poses", c.lidar_poses, "With --calib: est | gt | both")
       ->capture_default_str();
   cli.add_option("--seqs", c.seqs, "Folder mode: sequence names to evaluate (default: all)");
-  cli.add_option("--json", json, "Write the metrics report (schemas/metrics.schema.json)");
-  cli.add_option("--markdown", markdown, "Write the comparison as Markdown");
+  tool.OutputFile(
+      cli.add_option("--json", json, "Write the metrics report (schemas/metrics.schema.json)"));
+  tool.OutputFile(cli.add_option("--markdown", markdown, "Write the comparison as Markdown"));
   cli.add_option("--plot-dir", plot_dir, "Write PNG plots here (needs python3-matplotlib)");
   cli.add_option("--plot-script", plot_script, "Plotting script (default: scripts/plot_eval.py)");
   cli.add_option("--python", python, "Python interpreter for the plots (default: python3)");
@@ -49,6 +53,8 @@ int main(int argc, char** argv) {
     c.options.alignment = jvl::eval::ParseAlignment(align);
     c.options.association.mode = jvl::eval::ParseAssociationMode(assoc);
     c.options.rpe.unit = jvl::eval::ParseRpeUnit(rpe_unit);
+    // Checked before any work: an explicit --python that cannot plot is an error.
+    const std::string plot_python = plot_dir.empty() ? "" : jvl::tools::FindPlotPython(python);
     const jvl::tools::EvaluateRun run = jvl::tools::RunEvaluation(c);
     for (const std::string& input : run.inputs) tool.AddInput(input, /*same_dataset=*/false);
     std::fputs(jvl::eval::FormatTable(run.estimates, c.options).c_str(), stdout);
@@ -62,7 +68,7 @@ int main(int argc, char** argv) {
     }
     if (!plot_dir.empty()) {
       jvl::tools::MakePlots(plot_dir, jvl::eval::PlotData(run.estimates, c.options), plot_script,
-                            python);
+                            plot_python);
     }
     spdlog::info("evaluated {} estimate(s) in {:.3f} s", run.estimates.size(),
                  tool.MakeProvenance().wall_time_s);

@@ -30,9 +30,15 @@ EvaluateRun RunEvaluation(const EvaluateConfig& config);
 // The report body with the input paths added.
 nlohmann::json ReportBody(const EvaluateConfig& config, const EvaluateRun& run);
 
-// Writes <dir>/plot_data.json and runs scripts/plot_eval.py on it. Returns false (after a
-// warning naming the reason) when python3 or matplotlib is missing or the script fails.
+// The interpreter for the plots. `requested` (--python) must have matplotlib and numpy, else
+// this throws; without it, the first of python3 on PATH and /usr/bin/python3 that has them,
+// or "" (plots are skipped with a warning: they are optional).
+std::string FindPlotPython(const std::string& requested);
+
+// Writes <dir>/plot_data.json and runs scripts/plot_eval.py on it with `python` (from
+// FindPlotPython). Returns false (after a warning naming the reason) when there is no python,
+// the script is missing or it fails.
 bool MakePlots(const std::string& dir, const nlohmann::json& plot_data, std::string script,
-               std::string python);
+               const std::string& python);
 
 }  // namespace jvl::tools

@@ -32,13 +32,17 @@ int main(int argc, char** argv) {
   o.points_per_keyframe = 200;           // visual term on the longest tracks
   o.solve.function_tolerance = 1e-5;     // the last 1e-5 of the cost does not move the poses
   auto& cli = tool.cli();
-  cli.add_option("--local", local_path, "local artifact (local_map)")->required();
-  cli.add_option("--visual", visual_path, "visual artifact (visual_assoc)")->required();
-  cli.add_option("--directions", directions_path, "directions artifact (direction_cluster)");
-  cli.add_option("--prior", prior_path,
-                 "Full-rate prior to correct (.h5 artifact, KITTI, TUM); default: local's prior");
-  cli.add_option("-o,--output", output, "global artifact to write")->required();
-  cli.add_option("--kitti-poses", kitti, "Full-rate trajectory as KITTI poses text");
+  tool.InputFile(cli.add_option("--local", local_path, "local artifact (local_map)")->required());
+  tool.InputFile(
+      cli.add_option("--visual", visual_path, "visual artifact (visual_assoc)")->required());
+  tool.InputFile(
+      cli.add_option("--directions", directions_path, "directions artifact (direction_cluster)"));
+  tool.InputFile(cli.add_option(
+      "--prior", prior_path,
+      "Full-rate prior to correct (.h5 artifact, KITTI, TUM); default: local's prior"));
+  tool.OutputFile(cli.add_option("-o,--output", output, "global artifact to write")->required());
+  tool.OutputFile(
+      cli.add_option("--kitti-poses", kitti, "Full-rate trajectory as KITTI poses text"));
   cli.add_option("--alpha", o.joint.alpha, "Weight of the visual term")->capture_default_str();
   cli.add_option("--beta", o.joint.beta, "Weight of e_L (<= 0: from the residual counts)")
       ->capture_default_str();
@@ -103,7 +107,8 @@ int main(int argc, char** argv) {
   cli.add_flag("!--fixed-map-points", o.joint.optimize_map_points,
                "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only; "
                "several times faster on long sequences, see docs/global_opt.md)");
-  cli.add_option("--map", map_path, "Accumulated map PLY (stored scans, optimised poses)");
+  tool.OutputFile(
+      cli.add_option("--map", map_path, "Accumulated map PLY (stored scans, optimised poses)"));
   cli.add_option("--map-voxel", map_voxel, "Voxel size (m) of the map")->capture_default_str();
   cli.add_flag("--map-ascii", map_ascii, "Write the PLY as ASCII instead of binary");
   return tool.Run(argc, argv, [&] {
@@ -127,11 +132,11 @@ int main(int argc, char** argv) {
     Trajectory prior;
     const Timer reading;
     {
-      const auto visual = io::ReadVisualMap(visual_path);
       tool.AddInput(visual_path);
+      const auto visual = io::ReadVisualMap(visual_path);
       JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to optimise)");
-      auto local = global_opt::ReadLocalInput(local_path);
       tool.AddInput(local_path);
+      auto local = global_opt::ReadLocalInput(local_path);
       JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
                 local_path << " and " << visual_path << " have different keyframes ("
                            << local.keyframes.size() << " vs " << visual.keyframes.size()

@@ -50,15 +50,14 @@ int main(int argc, char** argv) {
       ->required();
   cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
-  cli.add_option("-o,--output", output, "Odometry artifact (.h5)")->required();
-  cli.add_option("--kitti-poses", kitti_poses, "Also write KITTI pose text here");
+  tool.OutputFile(cli.add_option("-o,--output", output, "Odometry artifact (.h5)")->required());
+  tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses, "Also write KITTI pose text here"));
   jvl::lidar_odom::AddOdometryOptions(cli, options);
   return tool.Run(argc, argv, [&] {
     options.Check();
     const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
                                               jvl::ParseFrameRange(frames));
-    tool.SetDatasetId(dataset->id(), dataset_dir);
-    for (const std::string& f : dataset->KeyFiles()) tool.AddInput(f);
+    tool.AddDataset(*dataset, dataset_dir);
     jvl::lidar::Odometry odometry(dataset->calibration().cam0_from_velo, options, tool.threads());
     jvl::io::OdometryArtifact artifact;
     const auto& ids = dataset->frames();

@@ -14,6 +14,14 @@
 #include "io/visual_io.h"
 #include "mapping/local_mapping.h"
 
+namespace {
+
+// Fewer surface points than this in a keyframe's scan is warned about: the IMLS term samples
+// up to 9 lists of --samples-per-list points and needs a spread of normals.
+constexpr size_t kFewSurfacePoints = 100;
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace jvl;
   app::Tool tool("local_map",
@@ -23,31 +31,33 @@ int main(int argc, char** argv) {
   mapping::LocalMappingOptions options;
   mapping::ScanOptions scan_options;
   auto& cli = tool.cli();
-  cli.add_option("--visual", visual_path, "visual.h5 from visual_assoc")->required();
+  tool.InputFile(
+      cli.add_option("--visual", visual_path, "visual.h5 from visual_assoc")->required());
   cli.add_option("--dataset", dataset_dir, "Dataset folder (the scans)")->required();
   cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
-  cli.add_option("--prior", prior_path,
-                 "Initial poses (.h5, KITTI or TUM); default: the visual artifact's prior");
-  cli.add_option("-o,--output", output, "Output local.h5")->required();
-  cli.add_option("--kitti-poses", kitti_poses, "Also write the refined keyframes as KITTI text");
+  tool.InputFile(
+      cli.add_option("--prior", prior_path,
+                     "Initial poses (.h5, KITTI or TUM); default: the visual artifact's prior"));
+  tool.OutputFile(cli.add_option("-o,--output", output, "Output local.h5")->required());
+  tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses,
+                                 "Also write the refined keyframes as KITTI text"));
   tools::AddLocalMapFlags(cli, &options, &scan_options);
   return tool.Run(argc, argv, [&] {
     options.Check();
     scan_options.Check();
-    const io::VisualMapData visual = io::ReadVisualMap(visual_path);
     tool.AddInput(visual_path);
+    const io::VisualMapData visual = io::ReadVisualMap(visual_path);
     JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to refine)");
     io::WarnIfCovisibilitySplit(visual, visual_path);
     Trajectory prior = visual.prior;
     if (!prior_path.empty()) {
-      prior = io::ReadTrajectory(prior_path);
       tool.AddInput(prior_path);
+      prior = io::ReadTrajectory(prior_path);
     }
     const auto input = mapping::MakeLocalMappingInput(
         visual, prior, prior_path.empty() ? visual_path + " (prior)" : prior_path);
     auto dataset = io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), FrameRange());
-    tool.SetDatasetId(dataset->id(), dataset_dir);
-    for (const auto& f : dataset->KeyFiles()) tool.AddInput(f);
+    tool.AddDataset(*dataset, dataset_dir);
     const Rigid3d cam0_from_velo = dataset->calibration().cam0_from_velo;
     // Candidates per sampling list, as lidar_odom: sampling stops after s accepted points.
     const size_t list_length = 20 * static_cast<size_t>(options.association.samples_per_list);
@@ -56,8 +66,18 @@ int main(int argc, char** argv) {
         input,
         [&](size_t row) {
           const PointCloud scan = dataset->LoadScan(input.frames[row]);
-          return mapping::PrepareKeyframeScan(scan, cam0_from_velo, scan_options, list_length,
-                                              tool.threads());
+          mapping::KeyframeScan prepared = mapping::PrepareKeyframeScan(
+              scan, cam0_from_velo, scan_options, list_length, tool.threads());
+          // An empty scan is reported by the dataset; a nearly empty or degenerate one (all
+          // points at the origin, a few points) leaves the keyframe's IMLS term weak or empty.
+          if (!scan.empty() && prepared.points.size() < kFewSurfacePoints) {
+            spdlog::warn(
+                "{}: only {} of {} points have a surface normal after filtering (frame {}): the "
+                "LiDAR term of this keyframe is weak",
+                dataset->ScanPath(input.frames[row]), prepared.points.size(), scan.size(),
+                input.frames[row]);
+          }
+          return prepared;
         },
         options, tool.threads(),
         [&](size_t, const mapping::KeyframeStats& s) {

@@ -12,9 +12,12 @@ int main(int argc, char** argv) {
   uint64_t seed = 1;
   double yaw_drift = 0, scale_bias = 0;
   auto& cli = tool.cli();
-  cli.add_option("--ground-truth,-g", gt_path, "Ground truth (KITTI/TUM text or .h5)")->required();
-  cli.add_option("--output,-o", output, "Prior: .h5 trajectory artifact or .txt (KITTI)")
-      ->required();
+  tool.InputFile(
+      cli.add_option("--ground-truth,-g", gt_path, "Ground truth (KITTI/TUM text or .h5)")
+          ->required());
+  tool.OutputFile(
+      cli.add_option("--output,-o", output, "Prior: .h5 trajectory artifact or .txt (KITTI)")
+          ->required());
   cli.add_option("--preset", preset, "lidar-n1, orbslam2, good or none")->capture_default_str();
   cli.add_option("--seed", seed, "Random seed")->capture_default_str();
   const CLI::Option* yaw_option =

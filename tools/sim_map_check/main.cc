@@ -32,27 +32,30 @@ int main(int argc, char** argv) {
   auto& cli = tool.cli();
   cli.add_option("--sequence", sequence_dir, "Simulated sequence folder (with sim/scene.json)")
       ->required();
-  cli.add_option("--visual", visual_path, "visual.h5 built from that sequence")->required();
+  tool.InputFile(
+      cli.add_option("--visual", visual_path, "visual.h5 built from that sequence")->required());
   cli.add_option("--max-depth", options.max_depth,
                  "Points deeper in their nearest view are skipped (m)")
       ->capture_default_str();
   cli.add_option("--threshold", options.threshold, "On the surface: perpendicular distance (m)")
       ->capture_default_str();
-  cli.add_option("--json", json_path, "Write the report (schemas/sim_map_check.schema.json)");
-  cli.add_option("--points-csv", csv_path, "Write one line per map point (diagnostics)");
+  tool.OutputFile(
+      cli.add_option("--json", json_path, "Write the report (schemas/sim_map_check.schema.json)"));
+  tool.OutputFile(
+      cli.add_option("--points-csv", csv_path, "Write one line per map point (diagnostics)"));
   return tool.Run(argc, argv, [&] {
     options.depth_bins = {0};
     for (double edge = 10; edge < options.max_depth; edge += 10) options.depth_bins.push_back(edge);
     options.depth_bins.push_back(options.max_depth);
     options.Check();
-    const auto world = jvl::tools::RebuildSequenceWorld(sequence_dir);
     // scene.json names the simulated world ('sim:<scenario>:<seed>'), not the dataset id the
     // stages record (from the folder's calib.txt and times.txt): the visual map is checked
     // against the latter.
-    tool.SetDatasetId(jvl::io::OpenDataset(sequence_dir)->id(), sequence_dir);
+    tool.AddDataset(*jvl::io::OpenDataset(sequence_dir), sequence_dir);
     tool.AddInput(sequence_dir + "/sim/scene.json", /*same_dataset=*/false);
-    const jvl::io::VisualMapData visual = jvl::io::ReadVisualMap(visual_path);
     tool.AddInput(visual_path);
+    const auto world = jvl::tools::RebuildSequenceWorld(sequence_dir);
+    const jvl::io::VisualMapData visual = jvl::io::ReadVisualMap(visual_path);
     const auto result = jvl::tools::RunMapCheck(*world, visual, options, tool.threads());
     if (result.max_keyframe_position_error_m > 0.01 ||
         result.max_keyframe_rotation_error_deg > 0.05) {

@@ -55,7 +55,7 @@ sim::SequenceOptions WorldOptionsFromScene(const nlohmann::json& scene, const st
     // Written since the terrain became scalable; older files have the default scale.
     o.scene.terrain_scale = Field(scene, "terrain", what).value("scale", 1.0);
   } catch (const nlohmann::json::exception& e) {
-    JVL_THROW(what << ": unexpected scene description: " << e.what());
+    JVL_THROW(what << ": unexpected scene description: " << io::JsonErrorText(e));
   }
   JVL_CHECK(o.frames > 0, what << ": no frames");
   o.render_images = false;
@@ -84,7 +84,7 @@ void CheckSameWorld(const sim::World& world, const nlohmann::json& scene,
              << " triangles, " << world.scene.buildings.size() << " buildings; the file has "
              << triangles << ", " << buildings << ")");
   } catch (const nlohmann::json::exception& e) {
-    JVL_THROW(what << ": unexpected scene description: " << e.what());
+    JVL_THROW(what << ": unexpected scene description: " << io::JsonErrorText(e));
   }
   if (!poses) return;
   JVL_CHECK(poses->frames == world.ground_truth.frames,

@@ -25,18 +25,19 @@ int main(int argc, char** argv) {
   cli.add_option("--dataset", dataset_dir, "Dataset folder (KITTI sequence)")->required();
   cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
-  cli.add_option("--prior", prior_path, "Prior trajectory (.h5, KITTI or TUM)")->required();
-  cli.add_option("--directions", directions_path, "directions.h5: its frames become keyframes");
-  cli.add_option("-o,--output", output, "Output visual.h5")->required();
+  tool.InputFile(
+      cli.add_option("--prior", prior_path, "Prior trajectory (.h5, KITTI or TUM)")->required());
+  tool.InputFile(cli.add_option("--directions", directions_path,
+                                "directions.h5: its frames become keyframes"));
+  tool.OutputFile(cli.add_option("-o,--output", output, "Output visual.h5")->required());
   tools::AddVisualMapFlags(cli, &options);
   return tool.Run(argc, argv, [&] {
     options.Check();
     auto dataset =
         io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
-    tool.SetDatasetId(dataset->id(), dataset_dir);
-    for (const auto& f : dataset->KeyFiles()) tool.AddInput(f);
-    const Trajectory prior = io::ReadTrajectory(prior_path);
+    tool.AddDataset(*dataset, dataset_dir);
     tool.AddInput(prior_path);
+    const Trajectory prior = io::ReadTrajectory(prior_path);
     const Trajectory poses = mapping::SelectPriorPoses(prior, dataset->frames(), prior_path);
     std::vector<int64_t> direction_frames;
     if (!directions_path.empty()) {

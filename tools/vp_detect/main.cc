@@ -22,8 +22,8 @@ int main(int argc, char** argv) {
       ->required();
   cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
-  cli.add_option("-o,--output", output, "Output artifact (vps.h5)")->required();
-  cli.add_option("--csv", csv, "Also write one CSV row per VP to this file");
+  tool.OutputFile(cli.add_option("-o,--output", output, "Output artifact (vps.h5)")->required());
+  tool.OutputFile(cli.add_option("--csv", csv, "Also write one CSV row per VP to this file"));
   cli.add_option("--debug-dir", run.debug_dir, "Write overlay images (segments by VP) here");
   cli.add_option("--detector", detector, "Line detector: fld or lsd")->capture_default_str();
   cli.add_option("--line-scale", seg.scale, "Resize factor before line detection")
@@ -56,8 +56,7 @@ int main(int argc, char** argv) {
     cv::setNumThreads(1);  // Parallelism is over frames; keep OpenCV single-threaded inside.
     const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
                                               jvl::ParseFrameRange(frames));
-    for (const std::string& f : dataset->KeyFiles()) tool.AddInput(f);
-    tool.SetDatasetId(dataset->id(), dataset_dir);
+    tool.AddDataset(*dataset, dataset_dir);
     const jvl::VpDetectRunResult result = jvl::RunVpDetect(*dataset, run);
     jvl::io::WriteVpsArtifact(output, result.data, tool.MakeProvenance());
     if (!csv.empty()) jvl::io::WriteVpsCsv(csv, result.data);
