@@ -4,6 +4,8 @@
 
 #include <glog/logging.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <cstdio>
 #include <thread>
 
@@ -62,6 +64,12 @@ int Tool::Run(int argc, const char* const* argv, const std::function<void()>& bo
   try {
     SetupLogging(log_level_);
     io::InstallInterruptCleanup();
+    // OpenCV picks SIMD code paths by the CPU it runs on (AVX2, AVX-512, ...), and they do not
+    // round alike: on one machine without them the simulator's images differed by a grey level
+    // in a few pixels and every later stage moved (local_map poses by 2 cm). Its baseline code
+    // gives the same bytes on every x86-64 machine, at no measurable cost to vp_detect or
+    // visual_assoc (docs/robustness.md, "Determinism").
+    cv::setUseOptimized(false);
     // Ceres logs through glog: keep its lines (e.g. thread-count notices) off the terminal;
     // the tools report what matters through their own log.
     static bool glog_ready = false;
