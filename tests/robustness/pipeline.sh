@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every stage on a short synthetic sequence, the way pipelines/demo chains them plus lidar_odom,
-# with a fixed thread count. Paths inside OUT are relative, so that the provenance (options and
-# input paths) of two runs in different folders is the same and the artifacts compare as equal.
+# with a fixed thread count: the fixture of the determinism test and of the sim golden files.
+# Paths inside OUT are relative, so that the provenance (options and input paths) of two runs in
+# different folders is the same and the artifacts compare as equal.
 #
 #   tests/robustness/pipeline.sh BIN_DIR OUT_DIR THREADS [FRAMES]
 set -euo pipefail
@@ -33,5 +34,7 @@ seq=data/sequences/00
   "${common[@]}" > /dev/null
 "$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 -o global.h5 \
   --kitti-poses global.txt --map map.ply "${common[@]}"
-"$bin/evaluate" --gt data/poses/00.txt --est prior.h5 --est odom.h5 --est global.h5 --align se3 \
-  --json metrics.json --markdown metrics.md "${common[@]}" > /dev/null
+"$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 --no-direction \
+  -o global_nodir.h5 "${common[@]}"
+"$bin/evaluate" --gt data/poses/00.txt --est prior.h5 --est odom.h5 --est global_nodir.h5 \
+  --est global.h5 --align se3 --json metrics.json --markdown metrics.md "${common[@]}" > /dev/null
