@@ -139,12 +139,17 @@ void DigestH5(const std::string& path, json* digest) {
     const std::vector<int64_t> dims = r.Dims(name);
     int64_t cols = 1;
     for (size_t i = 1; i < dims.size(); ++i) cols *= dims[i];
-    // Rows labelled by the frame ids of their group (trajectory/frames, keyframes/frames).
+    // Rows labelled by the frame ids of their group (trajectory/frames, keyframes/frames), or of
+    // the trajectory when the group has none and the row counts agree (odometry diagnostics).
     const std::string group = name.substr(0, name.find_last_of('/') + 1);
     std::vector<int64_t> ids;
-    const bool has_ids = !group.empty() && name != group + "frames" && r.Has(group + "frames") &&
-                         !dims.empty() && r.Dims(group + "frames") == std::vector<int64_t>{dims[0]};
-    if (has_ids) ids = r.ReadArray<int64_t>(group + "frames");
+    bool has_ids = false;
+    for (const std::string& frames : {group + "frames", std::string("trajectory/frames")}) {
+      if (has_ids || group.empty() || name == frames || !r.Has(frames) || dims.empty()) continue;
+      if (r.Dims(frames) != std::vector<int64_t>{dims[0]}) continue;
+      ids = r.ReadArray<int64_t>(frames);
+      has_ids = true;
+    }
     const std::string leaf = name.substr(group.size());
     const std::vector<std::string> columns =
         leaf == "poses" || leaf == "position" ? PoseColumns(cols) : std::vector<std::string>{};
@@ -334,7 +339,7 @@ class Comparer {
 
   // Row label: the frame / keyframe id where the artifact has one, else the row index.
   static std::string RowLabel(const json& field, size_t k) {
-    if (field.contains("ids")) return "id " + field["ids"][k].dump();
+    if (field.contains("ids")) return "frame " + field["ids"][k].dump();
     return "row " + field["rows"][k].dump();
   }
   static std::string ColumnLabel(const json& field, size_t c) {

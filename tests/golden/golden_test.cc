@@ -225,12 +225,12 @@ TEST_F(GoldenCompare, FloatsWithinTheirToleranceMatchAndBeyondAreReportedByFrame
   // Row 50 is not in the sample of 24 rows, so the column sum shows it.
   EXPECT_NE(report.find("trajectory/poses [sum over all rows, tz]"), std::string::npos) << report;
   EXPECT_NE(report.find("(test rule)"), std::string::npos) << report;
-  // A sampled row (the last, frame 109) is reported by its frame id and column name.
+  // A sampled row (the last, frame 109) is reported by its frame and column name.
   t = Line(100, 1.0);
   t.world_from_cam[99] = Rigid3d(Eigen::Quaterniond::Identity(), {0.5, 0, 99.0});
   const std::string last =
       Compare(golden, DigestOf(t, "b.h5"), Tolerances::Load(tolerances_path_)).Report("traj.h5");
-  EXPECT_NE(last.find("trajectory/poses [id 109, tx]: expected 0, found 0.5"), std::string::npos)
+  EXPECT_NE(last.find("trajectory/poses [frame 109, tx]: expected 0, found 0.5"), std::string::npos)
       << last;
 }
 
