@@ -4,8 +4,11 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <thread>
+#include <utility>
 
 #include "core/check.h"
+#include "io/files.h"
 #include "io/trajectory_io.h"
 
 namespace jvl::app {
@@ -79,6 +82,87 @@ TEST(ToolTest, InputsOfDifferentSequencesAreRejected) {
     tool.AddInput(dir + "/b.h5", /*same_dataset=*/false);  // evaluate: any sequence.
   }
   std::filesystem::remove_all(dir);
+}
+
+// Runs a tool with an input option --in and output options -o and --also; returns the exit code
+// and whether the body ran.
+std::pair<int, bool> RunWithPaths(const std::vector<std::string>& args) {
+  Tool tool("demo", "d");
+  std::string in, out, also;
+  tool.InputFile(tool.cli().add_option("--in", in, "input"));
+  tool.OutputFile(tool.cli().add_option("-o,--output", out, "output"));
+  tool.OutputFile(tool.cli().add_option("--also", also, "second output"));
+  std::vector<const char*> argv = {"demo"};
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  bool ran = false;
+  const int code = tool.Run(static_cast<int>(argv.size()), argv.data(), [&] { ran = true; });
+  return {code, ran};
+}
+
+TEST(ToolTest, OutputsThatAreInputsAreRefusedBeforeTheBody) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("jvl_tool_out_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "sub");
+  const std::string in = (dir / "in.txt").string();
+  io::WriteTextFileAtomic(in, "input\n");
+  fs::create_symlink(in, dir / "link.txt");
+  fs::create_hard_link(in, dir / "hard.txt");
+  const std::string out = (dir / "out.txt").string();
+  EXPECT_EQ(RunWithPaths({"--in", in, "-o", out}), std::make_pair(0, true));
+  for (const std::string& same :
+       std::vector<std::string>{in, (dir / "sub" / ".." / "in.txt").string(),
+                                (dir / "link.txt").string(), (dir / "hard.txt").string()}) {
+    EXPECT_EQ(RunWithPaths({"--in", in, "-o", same}), std::make_pair(1, false)) << same;
+  }
+  // Two outputs on one path (one of them not existing yet), and an output that is a folder.
+  EXPECT_EQ(RunWithPaths({"-o", out, "--also", (dir / "sub" / ".." / "out.txt").string()}),
+            std::make_pair(1, false));
+  EXPECT_EQ(RunWithPaths({"-o", (dir / "new.txt").string(), "--also", (dir / "new.txt").string()}),
+            std::make_pair(1, false));
+  EXPECT_EQ(RunWithPaths({"-o", (dir / "sub").string()}), std::make_pair(1, false));
+  EXPECT_EQ(io::ReadTextFile(in), "input\n");
+  {
+    // An input recorded during the body is checked too.
+    Tool tool("demo", "d");
+    std::string output;
+    tool.OutputFile(tool.cli().add_option("-o", output, "output"));
+    const char* argv[] = {"demo", "-o", in.c_str()};
+    EXPECT_EQ(tool.Run(3, argv, [&] { tool.AddInput(in); }), 1);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(ToolTest, ConfigKeysUnsignedValuesAndThreadCountsAreChecked) {
+  namespace fs = std::filesystem;
+  const std::string config =
+      (fs::temp_directory_path() / ("jvl_tool_cfg_" + std::to_string(::getpid()) + ".ini"))
+          .string();
+  io::WriteTextFileAtomic(config, "weight = 2\nno_such_key = 3\n");
+  {
+    Tool tool("demo", "d");
+    double weight = 1;
+    tool.cli().add_option("--weight", weight, "w");
+    const char* argv[] = {"demo", "--config", config.c_str()};
+    EXPECT_EQ(tool.Run(3, argv, [] {}), 2);  // unknown key
+  }
+  {
+    Tool tool("demo", "d");
+    uint64_t seed = 1;
+    tool.cli().add_option("--seed", seed, "s");
+    const char* argv[] = {"demo", "--seed", "-1"};
+    EXPECT_EQ(tool.Run(3, argv, [] {}), 2);
+    EXPECT_EQ(seed, 1u);
+  }
+  {
+    Tool tool("demo", "d");
+    const char* argv[] = {"demo", "--threads", "100000"};
+    EXPECT_EQ(tool.Run(3, argv, [] {}), 0);
+    const unsigned hw = std::thread::hardware_concurrency();
+    if (hw > 0) {
+      EXPECT_EQ(tool.threads(), static_cast<int>(hw));
+    }
+  }
+  std::filesystem::remove(config);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@ void SetupLogging(const std::string& level) {
   // from_str maps unknown names to "off"; only accept "off" when asked for.
   JVL_CHECK(parsed != spdlog::level::off || level == "off",
             "--log-level: unknown level '" << level << "' (trace, debug, info, warn, error, off)");
+  spdlog::drop("jvl");  // a second call (a second tool run in one process) replaces it
   auto logger = spdlog::stderr_color_mt("jvl");
   logger->set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
   logger->set_level(parsed);
