@@ -42,10 +42,7 @@ DatasetFormat DetectDatasetFormat(const std::string& dir) {
                    "calib.txt and velodyne/ or image_0/, or a KITTI raw *_sync folder)");
 }
 
-namespace {
-
-// Frame ids of the files "<number><ext>" in `dir`, sorted.
-std::map<int64_t, std::string> ListNumberedFiles(const fs::path& dir, const std::string& ext) {
+std::map<int64_t, std::string> ListNumberedFiles(const std::string& dir, const std::string& ext) {
   std::map<int64_t, std::string> files;
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return files;
@@ -57,11 +54,13 @@ std::map<int64_t, std::string> ListNumberedFiles(const fs::path& dir, const std:
   return files;
 }
 
-std::vector<int64_t> Keys(const std::map<int64_t, std::string>& files) {
+std::vector<int64_t> FrameIds(const std::map<int64_t, std::string>& files) {
   std::vector<int64_t> keys;
   for (const auto& [id, path] : files) keys.push_back(id);
   return keys;
 }
+
+namespace {
 
 std::string HashFiles(const std::vector<std::string>& paths) {
   Fnv1a64 hash;
@@ -146,9 +145,9 @@ class KittiOdometryDataset : public Dataset {
     root_ = dir;
     const fs::path p(dir);
     calibration_ = ReadKittiCalibration((p / "calib.txt").string());
-    const auto scans = ListNumberedFiles(p / "velodyne", ".bin");
-    const auto images = ListNumberedFiles(p / "image_0", ".png");
-    const std::vector<int64_t> all = DatasetFrames(Keys(scans), Keys(images), dir);
+    const auto scans = ListNumberedFiles((p / "velodyne").string(), ".bin");
+    const auto images = ListNumberedFiles((p / "image_0").string(), ".png");
+    const std::vector<int64_t> all = DatasetFrames(FrameIds(scans), FrameIds(images), dir);
     SelectFrames(all, range, dir, &frames_);
 
     const std::string times_path = (p / "times.txt").string();

@@ -2,6 +2,7 @@
 // KITTI raw drive folders. Frames are loaded lazily, one at a time.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -70,6 +71,9 @@ DatasetFormat DetectDatasetFormat(const std::string& dir);
 // - --frames must select at least one frame and may not end past the last one;
 // - a scan's non-finite points and points beyond kMaxScanRange are dropped with a warning, and
 //   an empty scan is warned about.
+// The files "<number><ext>" in `dir` by their number (none if `dir` is missing), and the numbers.
+std::map<int64_t, std::string> ListNumberedFiles(const std::string& dir, const std::string& ext);
+std::vector<int64_t> FrameIds(const std::map<int64_t, std::string>& files);
 std::vector<int64_t> DatasetFrames(const std::vector<int64_t>& scan_ids,
                                    const std::vector<int64_t>& image_ids, const std::string& dir);
 void SelectFrames(const std::vector<int64_t>& all, const FrameRange& range, const std::string& dir,

@@ -109,18 +109,6 @@ Rigid3d RigidFromRT(const std::vector<double>& r, const std::vector<double>& t,
   return Rigid3d::FromMatrix(m);
 }
 
-std::map<int64_t, std::string> ListNumbered(const fs::path& dir, const std::string& ext) {
-  std::map<int64_t, std::string> files;
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return files;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    if (entry.path().extension() != ext) continue;
-    const auto id = ParseInt(entry.path().stem().string());
-    if (id && *id >= 0) files[*id] = entry.path().string();
-  }
-  return files;
-}
-
 std::vector<std::string> ReadLines(const std::string& path) {
   std::ifstream in(path);
   JVL_CHECK(in.good(), path << ": not found");
@@ -167,12 +155,9 @@ class KittiRawDataset : public Dataset {
         RigidFromRT(Require(velo, "R", 9, v2c), Require(velo, "T", 3, v2c), v2c);
     calibration_.cam0_from_velo = rect_from_cam0 * cam0_from_velo_unrect;
 
-    scans_ = ListNumbered(drive / "velodyne_points" / "data", ".bin");
-    const auto images = ListNumbered(drive / "image_00" / "data", ".png");
-    std::vector<int64_t> scan_ids, image_ids;
-    for (const auto& entry : scans_) scan_ids.push_back(entry.first);
-    for (const auto& entry : images) image_ids.push_back(entry.first);
-    const std::vector<int64_t> all = DatasetFrames(scan_ids, image_ids, dir);
+    scans_ = ListNumberedFiles((drive / "velodyne_points" / "data").string(), ".bin");
+    const auto images = ListNumberedFiles((drive / "image_00" / "data").string(), ".png");
+    const std::vector<int64_t> all = DatasetFrames(FrameIds(scans_), FrameIds(images), dir);
     SelectFrames(all, range, dir, &frames_);
 
     // Timestamps of the LiDAR (or camera) stream, relative to the first line.
@@ -191,7 +176,7 @@ class KittiRawDataset : public Dataset {
     }
 
     // Ground truth from OXTS, as world_from_cam0 with frame 0's cam0 as the world.
-    const auto oxts = ListNumbered(drive / "oxts" / "data", ".txt");
+    const auto oxts = ListNumberedFiles((drive / "oxts" / "data").string(), ".txt");
     if (!oxts.empty()) {
       JVL_CHECK(oxts.rbegin()->first >= all.back(),
                 dir << ": oxts/data has " << oxts.size() << " packets but the drive has frame "
