@@ -6,6 +6,8 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <thread>
 
@@ -92,7 +94,7 @@ int Tool::Run(int argc, const char* const* argv, const std::function<void()>& bo
     body();
     return 0;
   } catch (const Error& e) {
-    std::fprintf(stderr, "%s: error: %s\n", name_.c_str(), e.message().c_str());
+    std::fprintf(stderr, "%s: error: %s\n", name_.c_str(), WithFlags(e.message()).c_str());
     spdlog::debug("raised at {}", e.what());
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "%s: error: out of memory\n", name_.c_str());
@@ -109,6 +111,38 @@ void Tool::SetDatasetId(const std::string& id, const std::string& source) {
   if (id.empty()) return;
   dataset_id_ = id;
   dataset_source_ = source;
+}
+
+void Tool::FieldFlag(const std::string& field, const std::string& flag) {
+  field_flags_[field] = flag;
+}
+
+std::string Tool::WithFlags(const std::string& message) const {
+  // Every snake_case word that names a field with a flag.
+  std::string out;
+  size_t i = 0;
+  while (i < message.size()) {
+    const auto word_char = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+    if (!word_char(message[i]) || (i > 0 && (word_char(message[i - 1]) || message[i - 1] == '-'))) {
+      out += message[i++];
+      continue;
+    }
+    size_t end = i;
+    while (end < message.size() && word_char(message[end])) ++end;
+    const std::string word = message.substr(i, end - i);
+    std::string flag;
+    if (const auto it = field_flags_.find(word); it != field_flags_.end()) {
+      flag = it->second;
+    } else if (word.find('_') != std::string::npos) {
+      std::string dashed = "--" + word;
+      std::replace(dashed.begin(), dashed.end(), '_', '-');
+      for (const CLI::Option* o : cli_.get_options())
+        if (o->check_name(dashed)) flag = dashed;
+    }
+    out += flag.empty() ? word : flag;
+    i = end;
+  }
+  return out;
 }
 
 CLI::Option* Tool::OutputFile(CLI::Option* option) {

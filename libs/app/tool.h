@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,11 @@ class Tool {
   CLI::Option* OutputFile(CLI::Option* option);
   // Marks an option as naming a file or folder this tool reads (checked against the outputs).
   CLI::Option* InputFile(CLI::Option* option);
+  // Library checks name the option fields they reject ("samples_per_list must be >= 1"); in the
+  // tool's error line a field is shown as its flag: the flag spelled like the field
+  // (--samples-per-list) if the tool has one, else the flag given here.
+  void FieldFlag(const std::string& field, const std::string& flag);
+
   // Records a dataset as input: its sequence id (SetDatasetId), its key files (AddInput), and
   // refuses an output that is one of the files the dataset's frames are read from.
   void AddDataset(const io::Dataset& dataset, const std::string& source);
@@ -62,10 +68,12 @@ class Tool {
   // Throws if `path` (an input, named by `what`) is the same file as one of the outputs.
   void CheckNotAnOutput(const std::string& path, const std::string& what) const;
   void CheckOutputs() const;
+  std::string WithFlags(const std::string& message) const;
 
   std::string name_;
   CLI::App cli_;
   std::vector<CLI::Option*> output_options_, input_options_;
+  std::map<std::string, std::string> field_flags_;
   int threads_ = 0;
   std::string log_level_ = "info";
   bool quiet_ = false;

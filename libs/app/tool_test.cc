@@ -165,5 +165,27 @@ TEST(ToolTest, ConfigKeysUnsignedValuesAndThreadCountsAreChecked) {
   std::filesystem::remove(config);
 }
 
+TEST(ToolTest, ErrorsNameFlagsInsteadOfFields) {
+  Tool tool("demo", "d");
+  int samples = 1;
+  double h = 1;
+  tool.cli().add_option("--samples-per-list", samples, "s");
+  tool.cli().add_option("--imls-h", h, "h");
+  tool.FieldFlag("kernel_h", "--imls-h");
+  testing::internal::CaptureStderr();
+  const char* argv[] = {"demo"};
+  EXPECT_EQ(tool.Run(1, argv,
+                     [] {
+                       JVL_THROW("samples_per_list must be >= 1 (kernel_h 0.3, max_distance "
+                                 "0.5, frames 2)");
+                     }),
+            1);
+  const std::string err = testing::internal::GetCapturedStderr();
+  // Fields with a flag become the flag; others (no such flag, plain words) stay.
+  EXPECT_EQ(err,
+            "demo: error: --samples-per-list must be >= 1 (--imls-h 0.3, max_distance 0.5, "
+            "frames 2)\n");
+}
+
 }  // namespace
 }  // namespace jvl::app

@@ -10,10 +10,6 @@
 namespace jvl::lidar {
 namespace {
 
-// Candidates looked at per sampling list, as a multiple of s (the lists are only partially
-// sorted; sampling stops at s accepted points).
-constexpr size_t kListLengthFactor = 20;
-
 // Constant velocity within the scan: a point taken at fraction s of the period was seen from
 // cur_from_sensor(s) = Exp(s Log(prev_from_cur)).
 void Deskew(const Rigid3d& prev_from_cur, PreprocessedScan* scan) {
@@ -28,11 +24,11 @@ void Deskew(const Rigid3d& prev_from_cur, PreprocessedScan* scan) {
 void OdometryOptions::Check() const {
   preprocess.Check();
   surface.Check();
+  association.Check();
   registration.Check();
-  JVL_CHECK(scan_map_size >= 1, "--scan-map-size must be >= 1, got " << scan_map_size);
-  JVL_CHECK(samples_per_list >= 1, "--samples-per-list must be >= 1, got " << samples_per_list);
+  JVL_CHECK(scan_map_size >= 1, "scan_map_size must be >= 1, got " << scan_map_size);
   JVL_CHECK(initial_search_scale >= 1,
-            "--initial-search-scale must be >= 1, got " << initial_search_scale);
+            "initial_search_scale must be >= 1, got " << initial_search_scale);
 }
 
 const char* ToString(FrameStatus status) {
@@ -53,7 +49,7 @@ Odometry::Odometry(const Rigid3d& cam0_from_velo, const OdometryOptions& options
     : cam0_from_velo_(cam0_from_velo),
       options_(options),
       threads_(std::max(1, threads)),
-      model_(options.registration.search_radius) {
+      model_(options.association.search_radius) {
   options_.Check();
 }
 
@@ -65,63 +61,53 @@ Rigid3d Odometry::PredictMotion() const {
 }
 
 RegistrationResult Odometry::Register(const ScanSurface& surface, const Rigid3d& predicted,
-                                      const RegistrationOptions& options, int per_list,
-                                      int* samples) const {
+                                      const AssociationOptions& association,
+                                      const RegistrationOptions& options, int* samples) const {
   // IMLS-SLAM sampling: s points per list with a model neighbour within r at the prediction.
-  const auto lists = SamplingLists(surface, kListLengthFactor * static_cast<size_t>(per_list));
-  const double r = options.search_radius;
-  const std::vector<int> picked = SelectSamples(lists, surface.size(), per_list, [&](int i) {
-    return model_.HasNeighbor(predicted * surface.points[i], r);
-  });
+  const SampledScan scan = SampleSurface(surface, association.samples_per_list);
+  const std::vector<int> picked = SelectSamples(scan, predicted, model_, association);
   std::vector<Eigen::Vector3d> points;
   std::vector<double> planarity;
   points.reserve(picked.size());
   for (const int i : picked) {
-    points.push_back(surface.points[i]);
-    planarity.push_back(surface.planarity[i]);
+    points.push_back(scan.points[i]);
+    planarity.push_back(scan.planarity[i]);
   }
   *samples = static_cast<int>(points.size());
-  return RegisterScan(points, model_, predicted, options, threads_, &planarity);
+  return RegisterScan(points, model_, predicted, association, options, threads_, &planarity);
 }
 
 RegistrationResult Odometry::Track(const ScanSurface& surface, const Rigid3d& predicted,
                                    int* samples) const {
-  const int s = options_.samples_per_list;
   Rigid3d start = predicted;
   if (frames_.size() == 1 && options_.initial_search_scale > 1) {
     // No velocity yet: a coarse registration with wider neighbourhoods seeds the normal one,
     // on a quarter of the samples (the wide neighbourhoods make each query ~20x dearer).
-    RegistrationOptions coarse = options_.registration;
+    AssociationOptions coarse = options_.association;
+    RegistrationOptions coarse_registration = options_.registration;
     const double k = options_.initial_search_scale;
     coarse.search_radius *= k;
     coarse.kernel_h *= k;
     coarse.max_distance *= k;
-    coarse.robust_scale *= k;
+    coarse.samples_per_list = std::max(1, coarse.samples_per_list / 4);
+    coarse_registration.robust_scale *= k;
     const RegistrationResult first =
-        Register(surface, predicted, coarse, std::max(1, s / 4), samples);
+        Register(surface, predicted, coarse, coarse_registration, samples);
     if (first.ok) start = first.world_from_scan;
   }
-  RegistrationResult reg = Register(surface, start, options_.registration, s, samples);
+  RegistrationResult reg =
+      Register(surface, start, options_.association, options_.registration, samples);
   if (reg.degenerate && start.translation() != predicted.translation()) {
     // Along unobservable directions the motion model, not the coarse pass, must be kept.
-    reg = Register(surface, predicted, options_.registration, s, samples);
+    reg = Register(surface, predicted, options_.association, options_.registration, samples);
   }
   return reg;
 }
 
 void Odometry::UpdateModel(int64_t frame, const ScanSurface& surface,
                            const Rigid3d& world_from_cam) {
-  std::vector<Eigen::Vector3d> points, normals;
-  points.reserve(surface.size());
-  normals.reserve(surface.size());
-  const Eigen::Quaterniond& q = world_from_cam.rotation();
-  for (size_t i = 0; i < surface.size(); ++i) {
-    if (!surface.valid[i]) continue;
-    points.push_back(world_from_cam * surface.points[i]);
-    normals.push_back(q * surface.normals[i]);
-  }
-  if (points.empty()) return;
-  model_.AddScan(frame, points, normals);
+  // Points without a normal have a zero one and are left out.
+  AddScanToModel(surface.points, surface.normals, world_from_cam, frame, &model_);
   while (model_.num_scans() > static_cast<size_t>(options_.scan_map_size)) {
     model_.RemoveScan(model_.scan_ids().front());
   }

@@ -14,6 +14,7 @@
 
 #include "geometry/point_cloud.h"
 #include "geometry/rigid3.h"
+#include "lidar/association.h"
 #include "lidar/imls.h"
 #include "lidar/preprocess.h"
 #include "lidar/registration.h"
@@ -24,9 +25,9 @@ namespace jvl::lidar {
 struct OdometryOptions {
   PreprocessOptions preprocess;
   SurfaceOptions surface;
+  AssociationOptions association;  // sampling (s = 100: up to 900 points) and Eq. (2)
   RegistrationOptions registration;
-  int scan_map_size = 10;      // N: scans kept in the model.
-  int samples_per_list = 100;  // s of IMLS-SLAM (9 lists -> up to 900 points).
+  int scan_map_size = 10;  // N: scans kept in the model.
   bool deskew = false;         // Constant-velocity de-skewing from the point azimuths.
   // Second scan (no motion estimate yet): a coarse registration first runs with the search
   // radius, kernel h, max distance and robust scale multiplied by this (1 = off).
@@ -82,7 +83,8 @@ class Odometry {
   RegistrationResult Track(const ScanSurface& surface, const Rigid3d& predicted,
                            int* samples) const;
   RegistrationResult Register(const ScanSurface& surface, const Rigid3d& predicted,
-                              const RegistrationOptions& options, int per_list, int* samples) const;
+                              const AssociationOptions& association,
+                              const RegistrationOptions& options, int* samples) const;
   void UpdateModel(int64_t frame, const ScanSurface& surface, const Rigid3d& world_from_cam);
 
   Rigid3d cam0_from_velo_;

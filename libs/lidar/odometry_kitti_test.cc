@@ -70,16 +70,16 @@ RunSummary RunKitti(const std::string& frames, const OdometryOptions& options) {
 
 OdometryOptions EnvOptions() {
   OdometryOptions o;
-  if (const char* v = std::getenv("JVL_H")) o.registration.kernel_h = std::atof(v);
-  if (const char* v = std::getenv("JVL_R")) o.registration.search_radius = std::atof(v);
+  if (const char* v = std::getenv("JVL_H")) o.association.kernel_h = std::atof(v);
+  if (const char* v = std::getenv("JVL_R")) o.association.search_radius = std::atof(v);
   if (const char* v = std::getenv("JVL_VOXEL")) o.preprocess.voxel_size = std::atof(v);
   if (const char* v = std::getenv("JVL_NR")) o.surface.normal_radius = std::atof(v);
   if (const char* v = std::getenv("JVL_N")) o.scan_map_size = std::atoi(v);
-  if (const char* v = std::getenv("JVL_S")) o.samples_per_list = std::atoi(v);
+  if (const char* v = std::getenv("JVL_S")) o.association.samples_per_list = std::atoi(v);
   if (const char* v = std::getenv("JVL_DESKEW")) o.deskew = std::atoi(v);
   if (const char* v = std::getenv("JVL_VC")) o.preprocess.vertical_correction_deg = std::atof(v);
   if (const char* v = std::getenv("JVL_SMALL")) o.preprocess.remove_small_objects = std::atoi(v);
-  if (const char* v = std::getenv("JVL_MAXD")) o.registration.max_distance = std::atof(v);
+  if (const char* v = std::getenv("JVL_MAXD")) o.association.max_distance = std::atof(v);
   if (const char* v = std::getenv("JVL_CT")) o.registration.convergence_translation = std::atof(v);
   if (const char* v = std::getenv("JVL_CR")) o.registration.convergence_rotation = std::atof(v);
   if (const char* v = std::getenv("JVL_K")) o.surface.normal_neighbors = std::atoi(v);

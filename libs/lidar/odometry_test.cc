@@ -110,7 +110,7 @@ TEST(OdometryTest, OptionsChecked) {
   o.scan_map_size = 0;
   EXPECT_THROW(o.Check(), std::exception);
   o = OdometryOptions();
-  o.registration.kernel_h = 0;
+  o.association.kernel_h = 0;
   EXPECT_THROW(Odometry(Rigid3d(), o, 1), std::exception);
 }
 

@@ -62,27 +62,27 @@ void Select(const std::vector<uint8_t>& keep, std::vector<T>* v) {
 }  // namespace
 
 void PreprocessOptions::Check() const {
-  JVL_CHECK(min_range >= 0, "--min-range must be >= 0, got " << min_range);
+  JVL_CHECK(min_range >= 0, "min_range must be >= 0, got " << min_range);
   JVL_CHECK(max_range == 0 || max_range > min_range,
-            "--max-range must be 0 or > --min-range, got " << max_range);
+            "max_range must be 0 or > min_range, got " << max_range);
   JVL_CHECK(
       std::abs(vertical_correction_deg) < 5,
-      "--vertical-correction must be a small angle in degrees, got " << vertical_correction_deg);
-  JVL_CHECK(voxel_size >= 0, "--voxel-size must be >= 0, got " << voxel_size);
-  JVL_CHECK(outlier_radius >= 0, "--outlier-radius must be >= 0, got " << outlier_radius);
+      "vertical_correction_deg must be a small angle in degrees, got " << vertical_correction_deg);
+  JVL_CHECK(voxel_size >= 0, "voxel_size must be >= 0, got " << voxel_size);
+  JVL_CHECK(outlier_radius >= 0, "outlier_radius must be >= 0, got " << outlier_radius);
   JVL_CHECK(outlier_method == "grid" || outlier_method == "pcl",
-            "--outlier-method must be grid or pcl, got '" << outlier_method << "'");
+            "outlier_method must be grid or pcl, got '" << outlier_method << "'");
   JVL_CHECK(outlier_min_neighbors >= 0,
-            "--outlier-min-neighbors must be >= 0, got " << outlier_min_neighbors);
-  JVL_CHECK(ground_distance > 0, "--ground-distance must be > 0, got " << ground_distance);
+            "outlier_min_neighbors must be >= 0, got " << outlier_min_neighbors);
+  JVL_CHECK(ground_distance > 0, "ground_distance must be > 0, got " << ground_distance);
   JVL_CHECK(ground_max_angle_deg > 0 && ground_max_angle_deg < 90,
-            "--ground-max-angle must be in (0, 90) degrees, got " << ground_max_angle_deg);
+            "ground_max_angle_deg must be in (0, 90) degrees, got " << ground_max_angle_deg);
   JVL_CHECK(ground_max_iterations > 0,
-            "--ground-iterations must be > 0, got " << ground_max_iterations);
-  JVL_CHECK(ground_max_samples >= 3, "--ground-samples must be >= 3, got " << ground_max_samples);
-  JVL_CHECK(cluster_cell > 0, "--cluster-cell must be > 0, got " << cluster_cell);
+            "ground_max_iterations must be > 0, got " << ground_max_iterations);
+  JVL_CHECK(ground_max_samples >= 3, "ground_max_samples must be >= 3, got " << ground_max_samples);
+  JVL_CHECK(cluster_cell > 0, "cluster_cell must be > 0, got " << cluster_cell);
   JVL_CHECK(small_object_horizontal >= 0 && small_object_height >= 0,
-            "small-object box extents must be >= 0");
+            "small_object_horizontal and small_object_height must be >= 0");
 }
 
 void CorrectVerticalAngle(double angle_rad, std::vector<Eigen::Vector3d>* velo_points) {
@@ -118,7 +118,7 @@ std::vector<uint8_t> RadiusOutlierMask(const std::vector<Eigen::Vector3d>& point
     });
     return keep;
   }
-  JVL_CHECK(method == "pcl", "--outlier-method must be grid or pcl, got '" << method << "'");
+  JVL_CHECK(method == "pcl", "outlier_method must be grid or pcl, got '" << method << "'");
   pcl::RadiusOutlierRemoval<pcl::PointXYZ> filter;
   filter.setInputCloud(ToPcl(points));
   filter.setRadiusSearch(radius);

@@ -21,7 +21,7 @@ struct Correspondence {
 // Projects every point (Eq. 2) at pose T; slots keep the order of `points`.
 std::vector<Correspondence> Associate(const std::vector<Eigen::Vector3d>& points,
                                       const ImlsModel& model, const Rigid3d& t,
-                                      const RegistrationOptions& o, int threads) {
+                                      const AssociationOptions& o, int threads) {
   std::vector<Correspondence> c(points.size());
   constexpr int64_t kChunk = 64;
   const int64_t chunks = (static_cast<int64_t>(points.size()) + kChunk - 1) / kChunk;
@@ -30,8 +30,7 @@ std::vector<Correspondence> Associate(const std::vector<Eigen::Vector3d>& points
     ImlsProjection p;
     for (size_t i = static_cast<size_t>(chunk * kChunk); i < end; ++i) {
       const Eigen::Vector3d x = t * points[i];
-      if (!model.Project(x, o.kernel_h, o.search_radius, &p)) continue;
-      if (std::abs(p.distance) > o.max_distance) continue;
+      if (!ProjectPoint(model, x, o, &p)) continue;
       c[i] = {true, x, p.normal, p.distance};
     }
   });
@@ -41,22 +40,22 @@ std::vector<Correspondence> Associate(const std::vector<Eigen::Vector3d>& points
 }  // namespace
 
 void RegistrationOptions::Check() const {
-  JVL_CHECK(max_iterations >= 1, "--max-iterations must be >= 1, got " << max_iterations);
-  JVL_CHECK(kernel_h > 0, "--imls-h must be > 0, got " << kernel_h);
-  JVL_CHECK(search_radius > 0, "--imls-radius must be > 0, got " << search_radius);
-  JVL_CHECK(max_distance > 0, "--max-distance must be > 0, got " << max_distance);
-  JVL_CHECK(robust_scale > 0, "--robust-scale must be > 0, got " << robust_scale);
-  JVL_CHECK(convergence_translation >= 0 && convergence_rotation >= 0,
-            "convergence thresholds must be >= 0");
+  JVL_CHECK(max_iterations >= 1, "max_iterations must be >= 1, got " << max_iterations);
+  JVL_CHECK(robust_scale > 0, "robust_scale must be > 0, got " << robust_scale);
+  JVL_CHECK(convergence_translation >= 0,
+            "convergence_translation must be >= 0, got " << convergence_translation);
+  JVL_CHECK(convergence_rotation >= 0,
+            "convergence_rotation must be >= 0, got " << convergence_rotation);
   JVL_CHECK(min_correspondences >= 6,
-            "--min-correspondences must be >= 6, got " << min_correspondences);
+            "min_correspondences must be >= 6, got " << min_correspondences);
   JVL_CHECK(degeneracy_threshold >= 0,
-            "--degeneracy-threshold must be >= 0, got " << degeneracy_threshold);
+            "degeneracy_threshold must be >= 0, got " << degeneracy_threshold);
 }
 
 RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, const ImlsModel& model,
-                                const Rigid3d& initial, const RegistrationOptions& options,
-                                int threads, const std::vector<double>* planarity) {
+                                const Rigid3d& initial, const AssociationOptions& association,
+                                const RegistrationOptions& options, int threads,
+                                const std::vector<double>* planarity) {
   JVL_CHECK(planarity == nullptr || planarity->size() == points.size(),
             "planarity has " << planarity->size() << " entries for " << points.size() << " points");
   RegistrationResult result;
@@ -68,7 +67,7 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, cons
   Rigid3d t = initial;
   Eigen::Matrix<double, 6, Eigen::Dynamic> weak_directions;  // Of the last iteration.
   for (int it = 0; it < options.max_iterations; ++it) {
-    const std::vector<Correspondence> corr = Associate(points, model, t, options, threads);
+    const std::vector<Correspondence> corr = Associate(points, model, t, association, threads);
     // Normal equations of sum w (I + J d)^2 with J = [n, ((x - c) x n) / L] and the rotation
     // applied about the sensor position c (keeps translation and rotation decoupled).
     Matrix6d h = Matrix6d::Zero(), h_obs = Matrix6d::Zero();

@@ -15,15 +15,13 @@
 #include <vector>
 
 #include "geometry/rigid3.h"
+#include "lidar/association.h"
 #include "lidar/imls.h"
 
 namespace jvl::lidar {
 
 struct RegistrationOptions {
   int max_iterations = 20;                // IMLS-SLAM uses 20.
-  double kernel_h = 0.3;                  // m, h of W_i in Eq. (2).
-  double search_radius = 0.6;             // m, r: model neighbours of Eq. (2).
-  double max_distance = 0.5;              // m, |I(x)| above this: no correspondence.
   double robust_scale = 0.1;              // m, Cauchy scale on I(x).
   double convergence_translation = 5e-4;  // m per iteration.
   double convergence_rotation = 5e-5;     // rad per iteration.
@@ -44,10 +42,12 @@ struct RegistrationResult {
   double min_eigenvalue = 0;  // Smallest normalised eigenvalue (last iteration).
 };
 
-// points: sampled scan points in the scan frame. initial: predicted world_from_scan.
+// points: sampled scan points in the scan frame. initial: predicted world_from_scan. The points
+// are projected on the model's surface with `association` (Eq. 2) at every iteration.
 // planarity (optional, a2D per point) weights the observability test by a2D^2.
 RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, const ImlsModel& model,
-                                const Rigid3d& initial, const RegistrationOptions& options,
-                                int threads, const std::vector<double>* planarity = nullptr);
+                                const Rigid3d& initial, const AssociationOptions& association,
+                                const RegistrationOptions& options, int threads,
+                                const std::vector<double>* planarity = nullptr);
 
 }  // namespace jvl::lidar

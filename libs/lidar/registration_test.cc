@@ -33,7 +33,8 @@ std::vector<Eigen::Vector3d> Sample(const std::vector<Eigen::Vector3d>& scan) {
 TEST(RegistrationTest, RecoversKnownTransformFromPerturbedStarts) {
   const std::vector<Eigen::Vector3d> world = testing::StreetScene(0.15);
   const RegistrationOptions options;
-  ImlsModel model(options.search_radius);
+  const AssociationOptions association;
+  ImlsModel model(association.search_radius);
   BuildModel(world, &model);
   const Rigid3d truth(ExpSO3(Eigen::Vector3d(0.01, -0.03, 0.02)), Eigen::Vector3d(0.4, -0.1, 1.2));
   // The scan sees the same street, 0.3 m voxel like the preprocessing, from the true pose.
@@ -50,7 +51,7 @@ TEST(RegistrationTest, RecoversKnownTransformFromPerturbedStarts) {
       (Vector6d() << 0, 0, 0, 0, -0.025, -0.015).finished()};
   for (const Vector6d& d : perturbations) {
     const Rigid3d start(ExpSO3(d.tail<3>()) * truth.rotation(), truth.translation() + d.head<3>());
-    const RegistrationResult r = RegisterScan(samples, model, start, options, 2);
+    const RegistrationResult r = RegisterScan(samples, model, start, association, options, 2);
     ASSERT_TRUE(r.ok);
     EXPECT_FALSE(r.degenerate) << r.min_eigenvalue;
     const Rigid3d err = truth.Inverse() * r.world_from_scan;
@@ -64,13 +65,14 @@ TEST(RegistrationTest, RecoversKnownTransformFromPerturbedStarts) {
 TEST(RegistrationTest, CorridorIsDetectedAndKeepsTheGuessAlongIt) {
   const std::vector<Eigen::Vector3d> world = testing::CorridorScene(0.15);
   const RegistrationOptions options;
-  ImlsModel model(options.search_radius);
+  const AssociationOptions association;
+  ImlsModel model(association.search_radius);
   BuildModel(world, &model);
   std::vector<Eigen::Vector3d> scan;
   for (const size_t i : VoxelDownsample(world, 0.3)) scan.push_back(world[i]);
   // Truth is the identity; the guess is off across (x, y) and along the corridor (z).
   const Rigid3d start(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.1, -0.08, 0.7));
-  const RegistrationResult r = RegisterScan(Sample(scan), model, start, options, 2);
+  const RegistrationResult r = RegisterScan(Sample(scan), model, start, association, options, 2);
   ASSERT_TRUE(r.ok);
   EXPECT_TRUE(r.degenerate);
   EXPECT_GE(r.degenerate_directions, 1);  // Along z; roll has a short lever arm (3 m).
@@ -82,13 +84,14 @@ TEST(RegistrationTest, CorridorIsDetectedAndKeepsTheGuessAlongIt) {
 
 TEST(RegistrationTest, EmptyModelOrScanReturnsGuessNotOk) {
   const RegistrationOptions options;
-  ImlsModel empty(options.search_radius);
+  const AssociationOptions association;
+  ImlsModel empty(association.search_radius);
   const Rigid3d guess(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1, 2, 3));
-  const RegistrationResult a = RegisterScan({{1, 1, 1}, {2, 2, 2}}, empty, guess, options, 1);
+  const RegistrationResult a = RegisterScan({{1, 1, 1}, {2, 2, 2}}, empty, guess, association, options, 1);
   EXPECT_FALSE(a.ok);
   EXPECT_EQ(a.correspondences, 0);
   EXPECT_LT((a.world_from_scan.translation() - guess.translation()).norm(), 1e-15);
-  const RegistrationResult b = RegisterScan({}, empty, guess, options, 1);
+  const RegistrationResult b = RegisterScan({}, empty, guess, association, options, 1);
   EXPECT_FALSE(b.ok);
 }
 

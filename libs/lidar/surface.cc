@@ -41,11 +41,11 @@ void FitLocalPlane(const std::vector<Eigen::Vector3d>& points,
 }  // namespace
 
 void SurfaceOptions::Check() const {
-  JVL_CHECK(normal_neighbors >= 3, "--normal-neighbors must be >= 3, got " << normal_neighbors);
-  JVL_CHECK(normal_radius > 0, "--normal-radius must be > 0, got " << normal_radius);
+  JVL_CHECK(normal_neighbors >= 3, "normal_neighbors must be >= 3, got " << normal_neighbors);
+  JVL_CHECK(normal_radius > 0, "normal_radius must be > 0, got " << normal_radius);
   JVL_CHECK(
       min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
-      "--min-normal-neighbors must be in [3, --normal-neighbors], got " << min_normal_neighbors);
+      "min_normal_neighbors must be in [3, normal_neighbors], got " << min_normal_neighbors);
 }
 
 ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,

@@ -59,10 +59,8 @@ void GlobalMapInput::Check() const {
 }
 
 void ImlsTraversalOptions::Check() const {
-  JVL_CHECK(scan_map_frames >= 1, "scan_map_frames (N) must be >= 1, got " << scan_map_frames);
-  JVL_CHECK(samples_per_list >= 0, "samples_per_list must be >= 0");
-  JVL_CHECK(kernel_h > 0 && search_radius > 0 && max_distance > 0,
-            "IMLS kernel_h, search_radius and max_distance must be > 0");
+  JVL_CHECK(scan_map_size >= 1, "scan_map_size (N) must be >= 1, got " << scan_map_size);
+  association.Check();
 }
 
 void GlobalMappingOptions::Check() const {
@@ -250,81 +248,57 @@ namespace {
 
 // First model keyframe for keyframe n (local mapping step 2): the first i with f_n - f_i <= N,
 // but always at least n - 1 so that sparse keyframes still get a model.
-size_t ModelStart(const Trajectory& keyframes, size_t n, int scan_map_frames) {
+size_t ModelStart(const Trajectory& keyframes, size_t n, int scan_map_size) {
   size_t start = n - 1;
-  while (start > 0 && keyframes.frames[n] - keyframes.frames[start - 1] <= scan_map_frames) --start;
+  while (start > 0 && keyframes.frames[n] - keyframes.frames[start - 1] <= scan_map_size) --start;
   return start;
 }
 
-void AddToModel(const Trajectory& keyframes, const std::vector<KeyframeScan>& scans, size_t i,
-                lidar::ImlsModel* model) {
-  const Rigid3d& world_from_i = keyframes.world_from_cam[i];
-  std::vector<Eigen::Vector3d> wp, wn;
-  for (size_t j = 0; j < scans[i].points.size(); ++j) {
-    if (scans[i].normals[j].squaredNorm() < 0.25f) continue;
-    wp.push_back(world_from_i * scans[i].points[j].cast<double>());
-    wn.push_back(world_from_i.rotation() * scans[i].normals[j].cast<double>());
+// The stored scan as a sampled one: IMLS-SLAM sampling on the stored normals (planarity taken
+// as 1: the stored scan keeps only points that had a normal).
+lidar::SampledScan Sampled(const lidar::StoredScan& stored, int samples_per_list) {
+  lidar::ScanSurface surface;
+  surface.points.reserve(stored.size());
+  surface.normals.reserve(stored.size());
+  for (size_t j = 0; j < stored.size(); ++j) {
+    surface.points.push_back(stored.points[j].cast<double>());
+    surface.normals.push_back(stored.normals[j].cast<double>());
+    surface.valid.push_back(surface.normals.back().squaredNorm() >= 0.25 ? 1 : 0);
   }
-  model->AddScan(static_cast<int64_t>(i), wp, wn);
+  surface.planarity.assign(stored.size(), 1.0);
+  return lidar::SampleSurface(surface, samples_per_list);
 }
 
 // Steps 3-4 for keyframe n against `model` (the scans of its window, current poses).
 std::vector<optim::ImlsCorrespondence> TraverseKeyframe(const Trajectory& keyframes,
-                                                        const std::vector<KeyframeScan>& scans,
+                                                        const std::vector<lidar::StoredScan>& scans,
                                                         size_t n, const lidar::ImlsModel& model,
-                                                        const ImlsTraversalOptions& options,
-                                                        int threads) {
+                                                        const ImlsTraversalOptions& options) {
   std::vector<optim::ImlsCorrespondence> out;
-  const KeyframeScan& scan = scans[n];
-  if (scan.points.empty() || model.size() == 0) return out;
-  // IMLS-SLAM sampling on the stored normals (planarity taken as 1: the stored scan keeps
-  // only points that had a normal).
-  lidar::ScanSurface surface;
-  surface.points.reserve(scan.points.size());
-  surface.normals.reserve(scan.points.size());
-  for (size_t j = 0; j < scan.points.size(); ++j) {
-    surface.points.push_back(scan.points[j].cast<double>());
-    surface.normals.push_back(scan.normals[j].cast<double>());
-  }
-  surface.planarity.assign(scan.points.size(), 1.0);
-  surface.valid.resize(scan.points.size());
-  for (size_t j = 0; j < scan.points.size(); ++j)
-    surface.valid[j] = surface.normals[j].squaredNorm() >= 0.25 ? 1 : 0;
-  const size_t per_list = static_cast<size_t>(options.samples_per_list);
-  const auto lists = lidar::SamplingLists(surface, 20 * per_list);
+  const lidar::AssociationOptions& a = options.association;
+  const lidar::SampledScan scan = Sampled(scans[n], a.samples_per_list);
   const Rigid3d& world_from_n = keyframes.world_from_cam[n];
-  const auto samples =
-      lidar::SelectSamples(lists, scan.points.size(), options.samples_per_list, [&](int j) {
-        return model.HasNeighbor(world_from_n * surface.points[j], options.search_radius);
-      });
-  std::vector<uint8_t> ok(samples.size(), 0);
-  std::vector<optim::ImlsCorrespondence> found(samples.size());
-  ParallelFor(static_cast<int64_t>(samples.size()), threads, [&](int64_t s) {
-    const int j = samples[s];
+  for (const int j : lidar::SelectSamples(scan, world_from_n, model, a)) {
     lidar::ImlsProjection proj;
-    if (!model.Project(world_from_n * surface.points[j], options.kernel_h, options.search_radius,
-                       &proj))
-      return;
-    if (std::abs(proj.distance) > options.max_distance || proj.nearest_scan < 0) return;
-    const size_t c = static_cast<size_t>(proj.nearest_scan);
-    const Rigid3d cam_from_world = keyframes.world_from_cam[c].Inverse();
-    optim::ImlsCorrespondence& l = found[s];
+    if (!lidar::ProjectPoint(model, world_from_n * scan.points[j], a, &proj)) continue;
+    if (proj.nearest_scan < 0) continue;
+    const Rigid3d cam_from_world =
+        keyframes.world_from_cam[static_cast<size_t>(proj.nearest_scan)].Inverse();
+    optim::ImlsCorrespondence l;
     l.n = static_cast<int64_t>(n);
-    l.c = static_cast<int64_t>(c);
-    l.p_x = surface.points[j];
+    l.c = proj.nearest_scan;
+    l.p_x = scan.points[j];
     l.c_p_y = cam_from_world * proj.projection;  // ^c p_y = T_cw p_y (step 4)
     l.c_normal = (cam_from_world.rotation() * proj.normal).normalized();
-    ok[s] = 1;
-  });
-  for (size_t s = 0; s < samples.size(); ++s)
-    if (ok[s]) out.push_back(found[s]);
+    out.push_back(l);
+  }
   return out;
 }
 
 }  // namespace
 
 std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
-                                                    const std::vector<KeyframeScan>& scans,
+                                                    const std::vector<lidar::StoredScan>& scans,
                                                     const ImlsTraversalOptions& options,
                                                     int threads) {
   options.Check();
@@ -340,17 +314,19 @@ std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
   const size_t chunks = k > 1 ? (k - 1 + kChunk - 1) / kChunk : 0;
   std::vector<std::vector<optim::ImlsCorrespondence>> parts(chunks);
   ParallelFor(static_cast<int64_t>(chunks), ResolveThreadCount(threads), [&](int64_t chunk) {
-    lidar::ImlsModel model(options.search_radius);
+    lidar::ImlsModel model(options.association.search_radius);
     const size_t first = 1 + static_cast<size_t>(chunk) * kChunk;
     const size_t last = std::min(k, first + kChunk);
     size_t next = 0;  // next scan to add
     for (size_t n = first; n < last; ++n) {
-      const size_t start = ModelStart(keyframes, n, options.scan_map_frames);
+      const size_t start = ModelStart(keyframes, n, options.scan_map_size);
       for (const int64_t id : model.scan_ids())
         if (static_cast<size_t>(id) < start) model.RemoveScan(id);
-      for (next = std::max(next, start); next < n; ++next)
-        AddToModel(keyframes, scans, next, &model);
-      auto l = TraverseKeyframe(keyframes, scans, n, model, options, 1);
+      for (next = std::max(next, start); next < n; ++next) {
+        lidar::AddScanToModel(scans[next].points, scans[next].normals,
+                              keyframes.world_from_cam[next], static_cast<int64_t>(next), &model);
+      }
+      auto l = TraverseKeyframe(keyframes, scans, n, model, options);
       parts[static_cast<size_t>(chunk)].insert(parts[static_cast<size_t>(chunk)].end(), l.begin(),
                                                l.end());
     }
@@ -504,7 +480,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
       result.traversal_time_s += t.ElapsedSeconds();
       spdlog::debug("round {}: fresh IMLS traversal {:.1f} s ({} correspondences)", round + 1,
                     t.ElapsedSeconds(), l.size());
-      if (round == rounds - 1) std::vector<KeyframeScan>().swap(input.scans);  // not needed now
+      if (round == rounds - 1) std::vector<lidar::StoredScan>().swap(input.scans);  // not needed now
     }
     // Warm-start round without e_D: the report's "before" is still the full energy at the input
     // poses. Its visual and IMLS parts are this round's; e_D's part is evaluated on its own with
@@ -645,7 +621,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
 }
 
 std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,
-                                           const std::vector<KeyframeScan>& scans,
+                                           const std::vector<lidar::StoredScan>& scans,
                                            double voxel_size) {
   JVL_CHECK(scans.size() == keyframes.size(),
             "AccumulateMap: " << scans.size() << " scans for " << keyframes.size() << " keyframes");

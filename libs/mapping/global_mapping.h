@@ -21,17 +21,10 @@
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
 #include "geometry/trajectory.h"
+#include "lidar/association.h"
 #include "optim/joint_problem.h"
 
 namespace jvl::mapping {
-
-// The preprocessed, voxel-downsampled scan of one keyframe in its own cam0 frame. Single
-// precision as stored in local.h5 (micrometres at 100 m; half the memory of doubles: 27 M points
-// on the 4500-frame run). Computations convert to double.
-struct KeyframeScan {
-  std::vector<Eigen::Vector3f> points;
-  std::vector<Eigen::Vector3f> normals;  // Unit; a zero normal marks a point without one.
-};
 
 // A VP of a frame associated with a direction prior d_w (directions artifact).
 struct DirectionAssociation {
@@ -52,18 +45,17 @@ struct GlobalMapInput {
   // compact form a caller may pass instead of millions of correspondences. Needs the compressed
   // e_L form (JointProblemOptions::compress_imls, no Huber kernel on e_L).
   std::vector<optim::ImlsPair> saved_imls_pairs;
-  std::vector<KeyframeScan> scans;                     // One per keyframe row (may be empty).
+  std::vector<lidar::StoredScan> scans;                     // One per keyframe row (may be empty).
   std::vector<DirectionAssociation> directions;        // Any frames; non-keyframes skipped.
   void Check() const;
 };
 
 // Fresh point-to-IMLS traversal (local mapping steps 2-4 for every keyframe).
 struct ImlsTraversalOptions {
-  int scan_map_frames = 10;    // N: model = keyframes i < n with f_n - f_i <= N (at least n-1).
-  int samples_per_list = 30;   // IMLS-SLAM sampling: points taken from each of the 9 lists.
-  double kernel_h = 0.3;       // m, h of W_i in Eq. (2).
-  double search_radius = 0.6;  // m, model neighbours of Eq. (2).
-  double max_distance = 0.5;   // m, |I(x)| above this: no correspondence.
+  int scan_map_size = 10;  // N: model = keyframes i < n with f_n - f_i <= N (at least n-1).
+  // Fewer samples per list than the local mapping's 100: the global problem holds every
+  // keyframe's correspondences at once.
+  lidar::AssociationOptions association{30};
   void Check() const;
 };
 
@@ -181,7 +173,7 @@ int64_t SelectObservations(std::vector<optim::VisualObservation>* observations, 
 // points of n's scan (IMLS-SLAM sampling on the stored normals) are projected onto it. Each
 // projection gives (n, c = keyframe of the nearest model point, p_x, c_p_y, n_c).
 std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
-                                                    const std::vector<KeyframeScan>& scans,
+                                                    const std::vector<lidar::StoredScan>& scans,
                                                     const ImlsTraversalOptions& options,
                                                     int threads);
 
@@ -199,7 +191,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& result,
 // Accumulated map: every keyframe's scan placed with `keyframes` poses, voxel-downsampled
 // (first point per voxel, keyframe order). voxel_size <= 0 keeps every point.
 std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,
-                                           const std::vector<KeyframeScan>& scans,
+                                           const std::vector<lidar::StoredScan>& scans,
                                            double voxel_size);
 
 }  // namespace jvl::mapping

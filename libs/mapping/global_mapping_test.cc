@@ -164,7 +164,7 @@ TEST(GlobalMapping, FreshTraversalAtTheGeneratingPosesHasCentimetreResiduals) {
   for (const auto& c : l) {
     EXPECT_LT(c.c, c.n);
     EXPECT_LE(syn.input.keyframes.frames[c.n] - syn.input.keyframes.frames[c.c],
-              std::max<int64_t>(to.scan_map_frames, so.frames_per_keyframe));
+              std::max<int64_t>(to.scan_map_size, so.frames_per_keyframe));
     const Eigen::Vector3d x = syn.input.keyframes.world_from_cam[c.c].Inverse() *
                               (syn.input.keyframes.world_from_cam[c.n] * c.p_x);
     abs_r.push_back(std::abs((x - c.c_p_y).dot(c.c_normal)));
@@ -190,8 +190,8 @@ AblationFigures RunAblation(const SyntheticGlobalOptions& so,
                             const GlobalMappingOptions& with = Quiet()) {
   auto syn = MakeSyntheticGlobal(so);
   ImlsTraversalOptions local;
-  local.scan_map_frames = 1;
-  local.samples_per_list = 10;
+  local.scan_map_size = 1;
+  local.association.samples_per_list = 10;
   syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
   GlobalMappingOptions without = Quiet();
   without.use_directions = false;

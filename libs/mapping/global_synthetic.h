@@ -76,7 +76,7 @@ inline Eigen::Vector3d Perceived(const std::vector<Rigid3d>& prior_kf, double st
 
 inline void AddScanPoint(const std::vector<Rigid3d>& prior_kf, double step,
                          const Rigid3d& cam_from_world, const Eigen::Vector3d& road,
-                         const Eigen::Vector3d& road_normal, double noise, KeyframeScan* scan) {
+                         const Eigen::Vector3d& road_normal, double noise, lidar::StoredScan* scan) {
   const Rigid3d frame = PriorAt(prior_kf, step, road.z());
   const Eigen::Vector3d n_w = frame.rotation() * road_normal;
   const Eigen::Vector3d p_w = Perceived(prior_kf, step, road) + noise * n_w;
@@ -117,7 +117,7 @@ inline SyntheticGlobal MakeSyntheticGlobal(const SyntheticGlobalOptions& o) {
   for (int k = 0; k < o.keyframes; ++k) {
     const Rigid3d cam_from_world = world[k].Inverse();
     const double s0 = o.step * k;
-    KeyframeScan scan;
+    lidar::StoredScan scan;
     for (double s = s0 - o.scan_range; s <= s0 + o.scan_range; s += sp) {
       for (double x = -7.5; x <= 7.5; x += sp)  // ground
         AddScanPoint(world, o.step, cam_from_world, {x + 0.3 * u(rng), 1.7, s + 0.3 * u(rng)},

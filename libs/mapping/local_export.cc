@@ -31,7 +31,7 @@ nlohmann::json SummarizeLocalMap(const LocalMappingResult& result,
                                  const LocalMappingOptions& options) {
   const auto& s = result.stats;
   size_t scan_points = 0;
-  for (const StoredScan& scan : result.scans) scan_points += scan.points.size();
+  for (const lidar::StoredScan& scan : result.scans) scan_points += scan.points.size();
   double total_ms = 0;
   for (const KeyframeStats& k : s) total_ms += k.time_ms;
   return {
@@ -74,9 +74,10 @@ io::LocalMapData ExportLocalMap(const LocalMappingInput& input, const LocalMappi
   }
   for (const Eigen::Vector3d& p : result.map_points) AppendVector(p, &d.mappoint_position);
   d.scan_offset.push_back(0);
-  for (const StoredScan& scan : result.scans) {
+  for (const lidar::StoredScan& scan : result.scans) {
     for (size_t i = 0; i < scan.points.size(); ++i) {
-      const Eigen::Vector3f p = scan.points[i].cast<float>(), n = scan.normals[i].cast<float>();
+      const Eigen::Vector3f& p = scan.points[i];
+      const Eigen::Vector3f& n = scan.normals[i];
       d.scan_points.insert(d.scan_points.end(), {p.x(), p.y(), p.z()});
       d.scan_normals.insert(d.scan_normals.end(), {n.x(), n.y(), n.z()});
     }

@@ -167,7 +167,7 @@ KeyframeStats LocalMapper::Process(size_t n, const ScanLoader& load_scan) {
   }
   const Rigid3d initial = result_.poses[n];
   scans_[n] = load_scan(n);
-  result_.scans[n] = {scans_[n].stored_points, scans_[n].stored_normals};
+  result_.scans[n] = scans_[n].stored;
   stats.scan_ms = timer.ElapsedMs();
 
   const std::vector<int64_t> local = LocalKeyframes(n, adjacency_);

@@ -62,13 +62,13 @@ LocalMappingInput MakeLocalMappingInput(const io::VisualMapData& visual, const T
 }
 
 void LocalMappingOptions::Check() const {
-  JVL_CHECK(scan_map_size >= 1, "--scan-map-size must be >= 1, got " << scan_map_size);
+  JVL_CHECK(scan_map_size >= 1, "scan_map_size must be >= 1, got " << scan_map_size);
   JVL_CHECK(min_model_keyframes >= 0,
-            "--min-model-keyframes must be >= 0, got " << min_model_keyframes);
+            "min_model_keyframes must be >= 0, got " << min_model_keyframes);
   JVL_CHECK(association_rounds >= 1,
-            "--association-rounds must be >= 1, got " << association_rounds);
+            "association_rounds must be >= 1, got " << association_rounds);
   JVL_CHECK(min_point_observations >= 1,
-            "--min-point-observations must be >= 1, got " << min_point_observations);
+            "min_point_observations must be >= 1, got " << min_point_observations);
   association.Check();
   joint.Check();
   solve.Check();

@@ -60,7 +60,7 @@ struct LocalMappingOptions {
   int min_point_observations = 2;
   // The next keyframe's initial pose keeps the prior motion from the refined previous one.
   bool propagate_corrections = true;
-  AssociationOptions association;
+  lidar::AssociationOptions association;
   optim::JointProblemOptions joint;  // alpha, beta (<= 0: the weights rule), noise, Huber.
   optim::SolveOptions solve;         // threads is overridden by RunLocalMapping's argument.
   void Check() const;
@@ -85,15 +85,11 @@ struct KeyframeStats {
   double scan_ms = 0, solve_ms = 0;
 };
 
-struct StoredScan {
-  std::vector<Eigen::Vector3d> points, normals;  // Keyframe cam0 frame.
-};
-
 struct LocalMappingResult {
   std::vector<Rigid3d> poses;                              // Refined world_from_cam0 per keyframe.
   std::vector<Eigen::Vector3d> map_points;                 // Refined (rows of the input).
   std::vector<optim::ImlsCorrespondence> correspondences;  // L; n, c are keyframe rows.
-  std::vector<StoredScan> scans;                           // Per keyframe.
+  std::vector<lidar::StoredScan> scans;                    // Per keyframe (cam0 frame).
   std::vector<KeyframeStats> stats;
 };
 

@@ -64,7 +64,7 @@ KittiLocalRun RunKittiLocal(const io::Dataset& dataset, const Trajectory& prior,
       input,
       [&](size_t row) {
         return PrepareKeyframeScan(dataset.LoadScan(input.frames[row]), cam0_from_velo,
-                                   ScanOptions(), 2000, 2);
+                                   ScanOptions(), LocalMappingOptions().association.samples_per_list, 2);
       },
       options, 2);
   std::vector<Rigid3d> truth;

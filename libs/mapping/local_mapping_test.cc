@@ -72,7 +72,7 @@ TEST(LocalMapping, ImlsResidualIsZeroAtTrueConfiguration) {
   }
   const lidar::ImlsModel model =
       BuildScanModel({&scans[0], &scans[1], &scans[2]}, {0, 1, 2}, truth, 0.6);
-  const auto corr = AssociateScan(3, scans[3], truth[3], model, truth, AssociationOptions());
+  const auto corr = AssociateScan(3, scans[3], truth[3], model, truth, lidar::AssociationOptions());
   ASSERT_GT(corr.size(), 500u);
   std::map<int64_t, int> per_c;
   double max_abs = 0;
@@ -93,7 +93,7 @@ TEST(LocalMapping, ImlsResidualIsZeroAtTrueConfiguration) {
   EXPECT_GE(per_c.size(), 2u);  // c is the keyframe of the nearest model point, not always one.
   // Away from the truth the same correspondences are violated.
   const Rigid3d moved = truth[3] * Rigid3d(Eigen::Quaterniond::Identity(), {0.1, -0.05, 0.2});
-  const auto shifted = AssociateScan(3, scans[3], moved, model, truth, AssociationOptions());
+  const auto shifted = AssociateScan(3, scans[3], moved, model, truth, lidar::AssociationOptions());
   double sum = 0;
   for (const auto& l : shifted) {
     const optim::PointToImlsCost cost(l.p_x, l.c_p_y, l.c_normal, 1.0);

@@ -11,6 +11,7 @@
 
 #include "geometry/point_cloud.h"
 #include "geometry/rigid3.h"
+#include "lidar/association.h"
 #include "lidar/imls.h"
 #include "lidar/preprocess.h"
 #include "lidar/surface.h"
@@ -28,34 +29,24 @@ struct ScanOptions {
 };
 
 // One keyframe's scan in its own cam0 frame, prepared once and reused by every optimisation the
-// keyframe takes part in.
+// keyframe takes part in: the sampled surface the association works on, and the copy stored in
+// the artifact.
 struct KeyframeScan {
-  std::vector<Eigen::Vector3d> points;    // Points with a valid normal (the model points).
-  std::vector<Eigen::Vector3d> normals;   // Unit, same rows.
-  std::vector<double> planarity;          // a2D of IMLS-SLAM, same rows.
-  std::array<std::vector<int>, 9> lists;  // Sampling lists over the rows above.
-  std::vector<Eigen::Vector3d> stored_points, stored_normals;  // Voxel-downsampled copy.
-  int64_t raw_points = 0;                                      // Input scan size.
+  lidar::SampledScan sampled;
+  lidar::StoredScan stored;  // voxel-downsampled (ScanOptions::stored_voxel)
+  int64_t raw_points = 0;    // input scan size
 };
 
 // Preprocessing (supplement 1.1), normals and sampling lists (IMLS-SLAM Sec. V) of a velodyne
-// scan. `max_list_length` bounds each sampling list (0 = all points).
+// scan, for samples_per_list points per list.
 KeyframeScan PrepareKeyframeScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
-                                 const ScanOptions& options, size_t max_list_length, int threads);
+                                 const ScanOptions& options, int samples_per_list, int threads);
 
 // Builds a KeyframeScan from points that already have normals (synthetic scans, tests): the
-// planarity is taken as 1 and the sampling lists are computed as for a real scan.
+// planarity is taken as 1 and the sampling lists are computed as for a real scan (whole lists).
 KeyframeScan KeyframeScanFromSurface(const std::vector<Eigen::Vector3d>& points,
                                      const std::vector<Eigen::Vector3d>& normals,
                                      double stored_voxel);
-
-struct AssociationOptions {
-  int samples_per_list = 100;  // s of IMLS-SLAM: up to 9 s sampled points.
-  double kernel_h = 0.3;       // m, h of W_i in Eq. (2).
-  double search_radius = 0.6;  // m, r: model neighbours of Eq. (2).
-  double max_distance = 0.5;   // m, |I(p_x)| above this gives no correspondence.
-  void Check() const;
-};
 
 // Step 2: S_model, the scans of `rows` (keyframe rows) placed with world_from_cam[row]; every
 // model point remembers its keyframe row (the scan id).
@@ -71,6 +62,6 @@ std::vector<optim::ImlsCorrespondence> AssociateScan(int64_t n, const KeyframeSc
                                                      const Rigid3d& world_from_n,
                                                      const lidar::ImlsModel& model,
                                                      const std::vector<Rigid3d>& world_from_cam,
-                                                     const AssociationOptions& options);
+                                                     const lidar::AssociationOptions& options);
 
 }  // namespace jvl::mapping

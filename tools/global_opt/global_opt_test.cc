@@ -107,8 +107,8 @@ class GlobalOptTest : public ::testing::Test {
     so.keyframes = 40;
     syn_ = MakeSyntheticGlobal(so);
     mapping::ImlsTraversalOptions local;
-    local.scan_map_frames = 1;
-    local.samples_per_list = 10;
+    local.scan_map_size = 1;
+    local.association.samples_per_list = 10;
     saved_ = mapping::TraverseImls(syn_.input.keyframes, syn_.input.scans, local, 1);
     WriteLocal(Path("local.h5"), syn_, saved_);
     io::WriteVisualMap(Path("visual.h5"), VisualOf(syn_), io::Provenance{});

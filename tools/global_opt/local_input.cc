@@ -14,9 +14,9 @@ Eigen::Vector3d Row3(const std::vector<T>& a, size_t i) {
 
 // The stored scans (single precision, as in the file), one per keyframe; all empty if the file
 // has none.
-std::vector<mapping::KeyframeScan> ScansOf(const io::LocalMapData& d) {
+std::vector<lidar::StoredScan> ScansOf(const io::LocalMapData& d) {
   const size_t k = d.keyframes.size();
-  std::vector<mapping::KeyframeScan> scans(k);
+  std::vector<lidar::StoredScan> scans(k);
   if (d.scan_offset.empty()) return scans;
   for (size_t i = 0; i < k; ++i) {
     // Sized up front: grown by push_back, the scans of a long sequence took up to twice their size.
@@ -52,7 +52,7 @@ LocalInput ToLocalInput(const io::LocalMapData& d) {
 
 LocalInput ReadLocalInput(const std::string& path) { return ToLocalInput(io::ReadLocalMap(path)); }
 
-std::vector<mapping::KeyframeScan> ReadLocalScans(const std::string& path) {
+std::vector<lidar::StoredScan> ReadLocalScans(const std::string& path) {
   return ScansOf(io::ReadLocalMap(path, io::LocalMapParts::kWithoutCorrespondences));
 }
 

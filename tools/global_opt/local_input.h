@@ -17,13 +17,13 @@ struct LocalInput {
   Trajectory keyframes;                         // refined
   std::vector<optim::ImlsCorrespondence> imls;  // n, c = keyframe rows
   std::vector<Eigen::Vector3d> mappoints;       // refined, visual.h5 rows
-  std::vector<mapping::KeyframeScan> scans;     // one per keyframe
+  std::vector<lidar::StoredScan> scans;     // one per keyframe
   Trajectory prior;                             // empty if absent
 };
 
 LocalInput ToLocalInput(const io::LocalMapData& data);
 LocalInput ReadLocalInput(const std::string& path);
 // Only the stored scans (for the map export after the optimisation has released its copy).
-std::vector<mapping::KeyframeScan> ReadLocalScans(const std::string& path);
+std::vector<lidar::StoredScan> ReadLocalScans(const std::string& path);
 
 }  // namespace jvl::global_opt

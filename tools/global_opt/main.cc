@@ -51,10 +51,10 @@ int main(int argc, char** argv) {
   cli.add_flag("--no-direction", no_direction, "Ablation: no direction projection residuals");
   cli.add_flag("--no-saved-imls", no_saved, "Leave out the saved correspondence set L");
   cli.add_flag("--no-fresh-imls", no_fresh, "Leave out the fresh IMLS traversal");
-  cli.add_option("--scan-map-frames", o.traversal.scan_map_frames,
-                 "N: model scans within N frames before each keyframe")
+  cli.add_option("--scan-map-size,--scan-map-frames", o.traversal.scan_map_size,
+                 "N: model scans within N frames before each keyframe (the paper's N)")
       ->capture_default_str();
-  cli.add_option("--samples-per-list", o.traversal.samples_per_list,
+  cli.add_option("--samples-per-list", o.traversal.association.samples_per_list,
                  "IMLS-SLAM samples per list (9 lists) in the fresh traversal")
       ->capture_default_str();
   cli.add_option("--max-iterations", o.solve.max_iterations,

@@ -53,6 +53,13 @@ int main(int argc, char** argv) {
   tool.OutputFile(cli.add_option("-o,--output", output, "Odometry artifact (.h5)")->required());
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses, "Also write KITTI pose text here"));
   jvl::lidar_odom::AddOdometryOptions(cli, options);
+  tool.FieldFlag("kernel_h", "--imls-h");
+  tool.FieldFlag("search_radius", "--imls-radius");
+  tool.FieldFlag("max_distance", "--imls-max-distance");
+  tool.FieldFlag("vertical_correction_deg", "--vertical-correction");
+  tool.FieldFlag("ground_max_angle_deg", "--ground-max-angle");
+  tool.FieldFlag("ground_max_iterations", "--ground-iterations");
+  tool.FieldFlag("ground_max_samples", "--ground-samples");
   return tool.Run(argc, argv, [&] {
     options.Check();
     const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),

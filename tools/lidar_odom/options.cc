@@ -9,8 +9,8 @@ void AddOdometryOptions(CLI::App& cli, lidar::OdometryOptions& o) {
   };
   const std::string model = "Model and sampling";
   add("--scan-map-size", o.scan_map_size, "N: scans kept in the model (paper's N)", model);
-  add("--samples-per-list", o.samples_per_list, "s: points per IMLS-SLAM sampling list (x9)",
-      model);
+  add("--samples-per-list", o.association.samples_per_list,
+      "s: points per IMLS-SLAM sampling list (x9)", model);
   add("--initial-search-scale", o.initial_search_scale,
       "Second scan (no velocity yet): coarse pass with neighbourhoods x this (1 = off)", model);
   cli.add_flag("--deskew,!--no-deskew", o.deskew, "Constant-velocity de-skewing of each scan")
@@ -51,9 +51,10 @@ void AddOdometryOptions(CLI::App& cli, lidar::OdometryOptions& o) {
   const std::string reg = "Registration";
   auto& r = o.registration;
   add("--max-iterations", r.max_iterations, "Iteration cap", reg);
-  add("--imls-h", r.kernel_h, "IMLS kernel width h of Eq. (2) (m)", reg);
-  add("--imls-radius", r.search_radius, "IMLS neighbourhood radius r (m)", reg);
-  add("--max-distance", r.max_distance, "Reject correspondences with |I(x)| above (m)", reg);
+  add("--imls-h", o.association.kernel_h, "IMLS kernel width h of Eq. (2) (m)", reg);
+  add("--imls-radius", o.association.search_radius, "IMLS neighbourhood radius r (m)", reg);
+  add("--imls-max-distance,--max-distance", o.association.max_distance,
+      "Reject correspondences with |I(x)| above (m)", reg);
   add("--robust-scale", r.robust_scale, "Cauchy loss scale on I(x) (m)", reg);
   add("--convergence-translation", r.convergence_translation,
       "Stop when the update is below this (m) ...", reg);

@@ -42,6 +42,10 @@ int main(int argc, char** argv) {
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses,
                                  "Also write the refined keyframes as KITTI text"));
   tools::AddLocalMapFlags(cli, &options, &scan_options);
+  tool.FieldFlag("kernel_h", "--imls-h");
+  tool.FieldFlag("search_radius", "--imls-radius");
+  tool.FieldFlag("max_distance", "--imls-max-distance");
+  tool.FieldFlag("stored_voxel", "--scan-voxel");
   return tool.Run(argc, argv, [&] {
     options.Check();
     scan_options.Check();
@@ -59,22 +63,21 @@ int main(int argc, char** argv) {
     auto dataset = io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), FrameRange());
     tool.AddDataset(*dataset, dataset_dir);
     const Rigid3d cam0_from_velo = dataset->calibration().cam0_from_velo;
-    // Candidates per sampling list, as lidar_odom: sampling stops after s accepted points.
-    const size_t list_length = 20 * static_cast<size_t>(options.association.samples_per_list);
     Progress progress("local_map", static_cast<int64_t>(input.size()), !tool.quiet());
     const mapping::LocalMappingResult result = mapping::RunLocalMapping(
         input,
         [&](size_t row) {
           const PointCloud scan = dataset->LoadScan(input.frames[row]);
           mapping::KeyframeScan prepared = mapping::PrepareKeyframeScan(
-              scan, cam0_from_velo, scan_options, list_length, tool.threads());
+              scan, cam0_from_velo, scan_options, options.association.samples_per_list,
+              tool.threads());
           // An empty scan is reported by the dataset; a nearly empty or degenerate one (all
           // points at the origin, a few points) leaves the keyframe's IMLS term weak or empty.
-          if (!scan.empty() && prepared.points.size() < kFewSurfacePoints) {
+          if (!scan.empty() && prepared.sampled.size() < kFewSurfacePoints) {
             spdlog::warn(
                 "{}: only {} of {} points have a surface normal after filtering (frame {}): the "
                 "LiDAR term of this keyframe is weak",
-                dataset->ScanPath(input.frames[row]), prepared.points.size(), scan.size(),
+                dataset->ScanPath(input.frames[row]), prepared.sampled.size(), scan.size(),
                 input.frames[row]);
           }
           return prepared;
