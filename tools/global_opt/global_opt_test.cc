@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <fstream>
 
-#include "assemble.h"
 #include "core/timer.h"
 #include "io/artifact.h"
 #include "io/files.h"
@@ -15,8 +14,8 @@
 #include "io/ply_io.h"
 #include "io/schema_check.h"
 #include "io/trajectory_io.h"
-#include "local_input.h"
-#include "mapping/global_synthetic.h"
+#include "mapping/global/global_artifact.h"
+#include "mapping/global/global_synthetic.h"
 
 namespace jvl::global_opt {
 namespace {
@@ -124,12 +123,13 @@ class GlobalOptTest : public ::testing::Test {
 };
 
 TEST_F(GlobalOptTest, ArtifactsAssembleToTheSameInput) {
-  const LocalInput local = ReadLocalInput(Path("local.h5"));
+  const mapping::StoredLocalMap local = mapping::ReadStoredLocalMap(Path("local.h5"));
   ASSERT_EQ(local.scans.size(), syn_.input.scans.size());
   EXPECT_EQ(local.imls.size(), saved_.size());
   EXPECT_EQ(local.prior.size(), syn_.prior.size());
   const auto dirs = io::ReadDirectionsArtifact(Path("directions.h5"));
-  const auto in = AssembleGlobalInput(io::ReadVisualMap(Path("visual.h5")), LocalInput(local), &dirs);
+  const auto in = mapping::AssembleGlobalInput(io::ReadVisualMap(Path("visual.h5")),
+                                               mapping::StoredLocalMap(local), &dirs);
   EXPECT_EQ(in.observations.size(), syn_.input.observations.size());
   EXPECT_EQ(in.map_points.size(), syn_.input.map_points.size());
   EXPECT_EQ(in.directions.size(), syn_.input.directions.size() + 1);

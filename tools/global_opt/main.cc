@@ -4,14 +4,14 @@
 #include <spdlog/spdlog.h>
 
 #include "app/tool.h"
-#include "assemble.h"
 #include "core/check.h"
 #include "core/memory.h"
 #include "core/timer.h"
 #include "io/global_io.h"
 #include "io/ply_io.h"
 #include "io/trajectory_io.h"
-#include "mapping/global_mapping.h"
+#include "mapping/global/global_artifact.h"
+#include "mapping/global/global_mapping.h"
 #include "optim/correction.h"
 
 int main(int argc, char** argv) {
@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
       const auto visual = io::ReadVisualMap(visual_path);
       JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to optimise)");
       tool.AddInput(local_path);
-      auto local = global_opt::ReadLocalInput(local_path);
+      auto local = mapping::ReadStoredLocalMap(local_path);
       JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
                 local_path << " and " << visual_path << " have different keyframes ("
                            << local.keyframes.size() << " vs " << visual.keyframes.size()
@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
       }
       JVL_CHECK(!prior.empty(), "no prior trajectory: pass --prior");
       o.joint.octave_scale_factor = visual.scale_factor;
-      input = global_opt::AssembleGlobalInput(visual, std::move(local),
+      input = mapping::AssembleGlobalInput(visual, std::move(local),
                                               directions_path.empty() ? nullptr : &directions);
     }
     if (o.use_saved_imls && o.joint.SumsImlsPerPair()) {
@@ -185,7 +185,7 @@ int main(int argc, char** argv) {
       // OptimizeGlobal released its scans before the last solve; they are read again.
       io::WritePly(map_path,
                    mapping::AccumulateMap(result.keyframes,
-                                          global_opt::ReadLocalScans(local_path), map_voxel),
+                                          mapping::ReadStoredScans(local_path), map_voxel),
                    !map_ascii);
     }
     spdlog::debug("outputs written in {:.1f} s", writing.ElapsedSeconds());

@@ -3,7 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "mapping/local_mapping.h"
+#include "mapping/local/local_mapping.h"
 
 namespace jvl::tools {
 

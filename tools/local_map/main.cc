@@ -12,7 +12,8 @@
 #include "io/local_io.h"
 #include "io/trajectory_io.h"
 #include "io/visual_io.h"
-#include "mapping/local_mapping.h"
+#include "mapping/local/local_artifact.h"
+#include "mapping/local/local_mapping.h"
 
 namespace {
 

@@ -14,8 +14,8 @@
 #include "io/schema_check.h"
 #include "io/visual_io.h"
 #include "map_check_run.h"
-#include "mapping/map_builder.h"
-#include "mapping/summary.h"
+#include "mapping/visual/map_builder.h"
+#include "mapping/visual/visual_artifact.h"
 #include "sim/describe.h"
 #include "sim/write_sequence.h"
 

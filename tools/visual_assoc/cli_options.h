@@ -3,7 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "mapping/map_builder.h"
+#include "mapping/visual/map_builder.h"
 
 namespace jvl::tools {
 

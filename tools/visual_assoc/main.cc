@@ -11,8 +11,8 @@
 #include "io/trajectory_io.h"
 #include "io/directions_io.h"
 #include "io/visual_io.h"
-#include "mapping/map_builder.h"
-#include "mapping/summary.h"
+#include "mapping/visual/map_builder.h"
+#include "mapping/visual/visual_artifact.h"
 
 int main(int argc, char** argv) {
   using namespace jvl;

@@ -1,4 +1,4 @@
-#include "mapping/local_scan.h"
+#include "mapping/local/local_scan.h"
 
 #include <cmath>
 

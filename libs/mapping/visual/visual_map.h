@@ -10,7 +10,6 @@
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
 #include "geometry/trajectory.h"
-#include "io/visual_io.h"
 #include "vision/guided_matching.h"
 #include "vision/orb_features.h"
 #include "vision/patch_align.h"
@@ -81,18 +80,5 @@ struct CovisibilityEdge {
 };
 // All keyframe pairs sharing at least min_weight map points, ordered by (a, b).
 std::vector<CovisibilityEdge> Covisibility(const VisualMap& map, int min_weight);
-
-// Flat artifact layout: good points only (renumbered), all keypoints of every keyframe,
-// observations ordered by (keyframe, keypoint), covisibility edges with weight >= min_weight.
-io::VisualMapData ExportVisualMap(const VisualMap& map, const Trajectory& prior, int min_weight);
-
-// Figures reported by visual_assoc and checked by the tests.
-struct VisualMapStats {
-  int keyframes = 0, mappoints = 0, observations = 0, edges = 0;
-  double median_points_per_keyframe = 0, min_points_per_keyframe = 0;
-  double mean_observations_per_point = 0;
-  double median_reprojection_px = 0, p90_reprojection_px = 0;
-};
-VisualMapStats ComputeStats(const io::VisualMapData& data);
 
 }  // namespace jvl::mapping

@@ -1,4 +1,4 @@
-#include "mapping/map_builder.h"
+#include "mapping/visual/map_builder.h"
 
 #include <algorithm>
 #include <map>

@@ -1,4 +1,4 @@
-#include "mapping/local_mapping.h"
+#include "mapping/local/local_mapping.h"
 
 #include <spdlog/spdlog.h>
 
@@ -28,37 +28,6 @@ void LocalMappingInput::Check() const {
     JVL_CHECK(e[0] >= 0 && e[1] >= 0 && static_cast<size_t>(std::max(e[0], e[1])) < k,
               "covisibility edge (" << e[0] << ", " << e[1] << ") out of range");
   }
-}
-
-LocalMappingInput MakeLocalMappingInput(const io::VisualMapData& visual, const Trajectory& prior,
-                                        const std::string& prior_name) {
-  LocalMappingInput in;
-  in.camera = visual.camera;
-  in.frames = visual.keyframes.frames;
-  in.map_poses = visual.keyframes.world_from_cam;
-  for (const int64_t f : in.frames) {
-    const auto i = prior.IndexOf(f);
-    JVL_CHECK(i.has_value(), prior_name << " has no pose for keyframe frame " << f);
-    in.prior.push_back(prior.world_from_cam[*i]);
-  }
-  for (size_t m = 0; m < visual.num_mappoints(); ++m) {
-    in.map_points.emplace_back(&visual.mappoint_position[3 * m]);
-  }
-  for (size_t o = 0; o < visual.num_observations(); ++o) {
-    const int32_t kp = visual.observation_keypoint[o];
-    optim::VisualObservation obs;
-    obs.keyframe = visual.observation_keyframe[o];
-    obs.map_point = visual.observation_mappoint[o];
-    obs.uv = Eigen::Vector2d(visual.keypoint_uv[2 * kp], visual.keypoint_uv[2 * kp + 1]);
-    obs.octave = visual.keypoint_octave[kp];
-    in.observations.push_back(obs);
-  }
-  for (size_t e = 0; e < visual.num_edges(); ++e) {
-    in.covisibility.push_back(
-        {visual.covisibility_edges[2 * e], visual.covisibility_edges[2 * e + 1]});
-  }
-  in.Check();
-  return in;
 }
 
 void LocalMappingOptions::Check() const {

@@ -2,7 +2,7 @@
 // and MapPointCulling), with the prior poses in place of the optimised ones.
 #include <algorithm>
 
-#include "mapping/map_builder.h"
+#include "mapping/visual/map_builder.h"
 
 namespace jvl::mapping {
 namespace {

@@ -4,7 +4,7 @@
 // model of the keyframes K_start..K_{n-1}, plus the saved correspondences of L whose two
 // keyframes are both in K_local (supplement Eq. 1).
 //
-//   LocalMappingInput in = MakeLocalMappingInput(visual, prior);
+//   LocalMappingInput in = MakeLocalMappingInput(visual, prior, "prior");  // local_artifact.h
 //   LocalMappingResult r = RunLocalMapping(in, [&](size_t row) { return PrepareKeyframeScan(..); },
 //                                          options, threads, on_keyframe);
 //
@@ -23,9 +23,7 @@
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
 #include "geometry/trajectory.h"
-#include "io/local_io.h"
-#include "io/visual_io.h"
-#include "mapping/local_scan.h"
+#include "mapping/local/local_scan.h"
 #include "optim/joint_problem.h"
 
 namespace jvl::mapping {
@@ -41,11 +39,6 @@ struct LocalMappingInput {
   size_t size() const { return frames.size(); }
   void Check() const;
 };
-
-// From the visual artifact; the initial poses are `prior` at the keyframe frames (every keyframe
-// frame must be in it). Observations carry the keypoint's pixel position and octave.
-LocalMappingInput MakeLocalMappingInput(const io::VisualMapData& visual, const Trajectory& prior,
-                                        const std::string& prior_name);
 
 struct LocalMappingOptions {
   int scan_map_size = 10;  // N: K_start is the first keyframe with f_n - f_i <= N (step 2).
@@ -126,8 +119,5 @@ Trajectory RefinedKeyframes(const LocalMappingInput& input, const LocalMappingRe
 nlohmann::json SummarizeLocalMap(const LocalMappingResult& result,
                                  const LocalMappingOptions& options);
 
-// The "local" artifact layout; `prior` is stored as the full prior trajectory.
-io::LocalMapData ExportLocalMap(const LocalMappingInput& input, const LocalMappingResult& result,
-                                const Trajectory& prior, const nlohmann::json& summary);
 
 }  // namespace jvl::mapping

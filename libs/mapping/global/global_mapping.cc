@@ -1,5 +1,5 @@
 // Global joint optimisation (Sec. 4.3): problem assembly, fresh IMLS traversal, map export.
-#include "mapping/global_mapping.h"
+#include "mapping/global/global_mapping.h"
 
 #include <spdlog/spdlog.h>
 

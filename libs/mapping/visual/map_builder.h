@@ -17,8 +17,8 @@
 
 #include "geometry/camera.h"
 #include "geometry/trajectory.h"
-#include "mapping/keyframe_rule.h"
-#include "mapping/visual_map.h"
+#include "mapping/visual/keyframe_rule.h"
+#include "mapping/visual/visual_map.h"
 #include "vision/guided_matching.h"
 #include "vision/orb_features.h"
 #include "vision/triangulation.h"

@@ -12,11 +12,13 @@
 #include "io/schema_check.h"
 #include "io/trajectory_io.h"
 #include "lidar/odometry.h"
-#include "mapping/local_mapping.h"
-#include "mapping/local_test_scene.h"
-#include "mapping/local_test_util.h"
-#include "mapping/map_builder.h"
-#include "mapping/visual_map.h"
+#include "mapping/local/local_artifact.h"
+#include "mapping/local/local_mapping.h"
+#include "mapping/local/local_test_scene.h"
+#include "mapping/local/local_test_util.h"
+#include "mapping/visual/map_builder.h"
+#include "mapping/visual/visual_artifact.h"
+#include "mapping/visual/visual_map.h"
 
 namespace jvl::mapping {
 namespace {

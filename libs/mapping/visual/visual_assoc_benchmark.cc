@@ -10,8 +10,8 @@
 
 #include "io/dataset.h"
 #include "io/trajectory_io.h"
-#include "mapping/map_builder.h"
-#include "mapping/summary.h"
+#include "mapping/visual/map_builder.h"
+#include "mapping/visual/visual_artifact.h"
 
 namespace {
 

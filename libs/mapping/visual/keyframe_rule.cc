@@ -1,4 +1,4 @@
-#include "mapping/keyframe_rule.h"
+#include "mapping/visual/keyframe_rule.h"
 
 #include "core/check.h"
 

@@ -1,12 +1,13 @@
-#include "mapping/local_mapping.h"
+#include "mapping/local/local_mapping.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
 
-#include "mapping/local_test_scene.h"
-#include "mapping/local_test_util.h"
+#include "mapping/local/local_artifact.h"
+#include "mapping/local/local_test_scene.h"
+#include "mapping/local/local_test_util.h"
 #include "optim/cost_functions.h"
 
 namespace jvl::mapping {

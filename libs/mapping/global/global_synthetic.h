@@ -18,7 +18,7 @@
 
 #include "geometry/camera.h"
 #include "geometry/trajectory.h"
-#include "mapping/global_mapping.h"
+#include "mapping/global/global_mapping.h"
 
 namespace jvl::mapping::testing {
 

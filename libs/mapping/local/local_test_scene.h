@@ -12,7 +12,7 @@
 
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
-#include "mapping/local_mapping.h"
+#include "mapping/local/local_mapping.h"
 
 namespace jvl::mapping::testing {
 

@@ -1,7 +1,7 @@
-// Result export of local mapping: refined trajectory, summary and the "local" artifact layout.
+// Results of local mapping as plain values: the refined keyframes and the run summary.
 #include <algorithm>
 
-#include "mapping/local_mapping.h"
+#include "mapping/local/local_mapping.h"
 
 namespace jvl::mapping {
 namespace {
@@ -15,9 +15,6 @@ double Quantile(const std::vector<T>& items, double q, F&& get) {
   return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
-void AppendVector(const Eigen::Vector3d& v, std::vector<double>* out) {
-  out->insert(out->end(), {v.x(), v.y(), v.z()});
-}
 
 }  // namespace
 
@@ -58,42 +55,6 @@ nlohmann::json SummarizeLocalMap(const LocalMappingResult& result,
       {"alpha", options.joint.alpha},
       {"beta", options.joint.beta},
   };
-}
-
-io::LocalMapData ExportLocalMap(const LocalMappingInput& input, const LocalMappingResult& result,
-                                const Trajectory& prior, const nlohmann::json& summary) {
-  io::LocalMapData d;
-  d.camera = input.camera;
-  d.keyframes = RefinedKeyframes(input, result);
-  for (const optim::ImlsCorrespondence& l : result.correspondences) {
-    d.imls_n.push_back(static_cast<int32_t>(l.n));
-    d.imls_c.push_back(static_cast<int32_t>(l.c));
-    AppendVector(l.p_x, &d.imls_p_x);
-    AppendVector(l.c_p_y, &d.imls_p_y);
-    AppendVector(l.c_normal, &d.imls_normal);
-  }
-  for (const Eigen::Vector3d& p : result.map_points) AppendVector(p, &d.mappoint_position);
-  d.scan_offset.push_back(0);
-  for (const lidar::StoredScan& scan : result.scans) {
-    for (size_t i = 0; i < scan.points.size(); ++i) {
-      const Eigen::Vector3f& p = scan.points[i];
-      const Eigen::Vector3f& n = scan.normals[i];
-      d.scan_points.insert(d.scan_points.end(), {p.x(), p.y(), p.z()});
-      d.scan_normals.insert(d.scan_normals.end(), {n.x(), n.y(), n.z()});
-    }
-    d.scan_offset.push_back(d.scan_offset.back() + static_cast<int64_t>(scan.points.size()));
-  }
-  for (const KeyframeStats& k : result.stats) {
-    d.stats_frame.push_back(k.frame);
-    d.stats_visual_residuals.push_back(k.visual_residuals);
-    d.stats_imls_residuals.push_back(k.imls_residuals);
-    d.stats_cost_before.push_back(k.cost_before);
-    d.stats_cost_after.push_back(k.cost_after);
-    d.stats_time_ms.push_back(k.time_ms);
-  }
-  d.prior = prior;
-  d.summary = summary;
-  return d;
 }
 
 }  // namespace jvl::mapping

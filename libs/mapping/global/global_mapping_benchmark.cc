@@ -5,8 +5,8 @@
 #include <benchmark/benchmark.h>
 
 #include "core/timer.h"
-#include "mapping/global_mapping.h"
-#include "mapping/global_synthetic.h"
+#include "mapping/global/global_mapping.h"
+#include "mapping/global/global_synthetic.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "mapping/global_mapping.h"
+#include "mapping/global/global_mapping.h"
 
 #include <ceres/crs_matrix.h>
 #include <ceres/problem.h>
@@ -10,7 +10,7 @@
 
 #include "core/check.h"
 #include "core/timer.h"
-#include "mapping/global_synthetic.h"
+#include "mapping/global/global_synthetic.h"
 #include "optim/correction.h"
 #include "optim/joint_problem.h"
 #include "optim/pose_block.h"

@@ -1,4 +1,4 @@
-#include "mapping/map_builder.h"
+#include "mapping/visual/map_builder.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,8 @@
 #include <random>
 
 #include "core/check.h"
-#include "mapping/visual_map.h"
+#include "mapping/visual/visual_artifact.h"
+#include "mapping/visual/visual_map.h"
 
 namespace jvl::mapping {
 namespace {

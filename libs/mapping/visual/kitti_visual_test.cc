@@ -6,9 +6,9 @@
 #include "io/dataset.h"
 #include "io/trajectory_io.h"
 #include "io/visual_io.h"
-#include "mapping/map_builder.h"
-#include "mapping/summary.h"
-#include "mapping/visual_map.h"
+#include "mapping/visual/map_builder.h"
+#include "mapping/visual/visual_artifact.h"
+#include "mapping/visual/visual_map.h"
 
 namespace jvl::mapping {
 namespace {

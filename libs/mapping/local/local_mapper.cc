@@ -7,7 +7,7 @@
 
 #include "core/check.h"
 #include "core/timer.h"
-#include "mapping/local_mapping.h"
+#include "mapping/local/local_mapping.h"
 
 namespace jvl::mapping {
 namespace {

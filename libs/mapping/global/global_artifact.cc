@@ -1,0 +1,99 @@
+#include "mapping/global/global_artifact.h"
+
+#include <map>
+#include <utility>
+
+#include "core/check.h"
+#include "mapping/local/local_artifact.h"
+
+namespace jvl::mapping {
+
+namespace {
+
+template <typename T>
+Eigen::Vector3d Row3(const std::vector<T>& a, size_t i) {
+  return Eigen::Vector3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+}
+
+// The stored scans (single precision, as in the file), one per keyframe; all empty if the file
+// has none.
+std::vector<lidar::StoredScan> ScansOf(const io::LocalMapData& d) {
+  const size_t k = d.keyframes.size();
+  std::vector<lidar::StoredScan> scans(k);
+  if (d.scan_offset.empty()) return scans;
+  for (size_t i = 0; i < k; ++i) {
+    // Sized up front: grown by push_back, the scans of a long sequence took up to twice their size.
+    const auto count = static_cast<size_t>(d.scan_offset[i + 1] - d.scan_offset[i]);
+    scans[i].points.reserve(count);
+    scans[i].normals.reserve(count);
+    for (int64_t j = d.scan_offset[i]; j < d.scan_offset[i + 1]; ++j) {
+      const size_t r = 3 * static_cast<size_t>(j);
+      scans[i].points.emplace_back(d.scan_points[r], d.scan_points[r + 1], d.scan_points[r + 2]);
+      scans[i].normals.emplace_back(d.scan_normals[r], d.scan_normals[r + 1],
+                                    d.scan_normals[r + 2]);
+    }
+  }
+  return scans;
+}
+
+}  // namespace
+
+StoredLocalMap ToStoredLocalMap(const io::LocalMapData& d) {
+  StoredLocalMap out;
+  out.keyframes = d.keyframes;
+  out.imls.reserve(d.num_correspondences());
+  for (size_t i = 0; i < d.num_correspondences(); ++i)
+    out.imls.push_back({d.imls_n[i], d.imls_c[i], Row3(d.imls_p_x, i), Row3(d.imls_p_y, i),
+                        Row3(d.imls_normal, i).normalized()});
+  out.mappoints.reserve(d.num_mappoints());
+  for (size_t i = 0; i < d.num_mappoints(); ++i)
+    out.mappoints.push_back(Row3(d.mappoint_position, i));
+  out.scans = ScansOf(d);
+  out.prior = d.prior;
+  return out;
+}
+
+StoredLocalMap ReadStoredLocalMap(const std::string& path) {
+  return ToStoredLocalMap(io::ReadLocalMap(path));
+}
+
+std::vector<lidar::StoredScan> ReadStoredScans(const std::string& path) {
+  return ScansOf(io::ReadLocalMap(path, io::LocalMapParts::kWithoutCorrespondences));
+}
+
+GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual, StoredLocalMap&& local,
+                                            const io::DirectionsData* directions) {
+  JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
+            "local and visual artifacts have different keyframes ("
+                << local.keyframes.size() << " vs " << visual.keyframes.size() << ")");
+  GlobalMapInput in;
+  in.camera = visual.camera;
+  in.keyframes = local.keyframes;
+  const size_t m = visual.num_mappoints();
+  if (!local.mappoints.empty()) {
+    JVL_CHECK(local.mappoints.size() == m,
+              "local has " << local.mappoints.size() << " map points, visual " << m);
+    in.map_points = std::move(local.mappoints);
+  } else {
+    for (size_t i = 0; i < m; ++i)
+      in.map_points.emplace_back(visual.mappoint_position[3 * i],
+                                 visual.mappoint_position[3 * i + 1],
+                                 visual.mappoint_position[3 * i + 2]);
+  }
+  in.observations = VisualObservations(visual);
+  in.saved_imls = std::move(local.imls);
+  in.scans = std::move(local.scans);
+  if (directions != nullptr) {
+    std::map<int32_t, Eigen::Vector3d> d_w;
+    for (const auto& c : directions->clusters) d_w[c.id] = c.direction;
+    for (const auto& a : directions->associations) {
+      const auto it = d_w.find(a.cluster);
+      JVL_CHECK(it != d_w.end(),
+                "association of frame " << a.frame << " names unknown cluster " << a.cluster);
+      in.directions.push_back({a.frame, a.uv, it->second, a.cluster});
+    }
+  }
+  return in;
+}
+
+}  // namespace jvl::mapping
