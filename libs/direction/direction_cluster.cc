@@ -9,15 +9,12 @@
 #include "core/check.h"
 #include "direction/ground.h"
 #include "direction/mean_shift.h"
+#include "geometry/angles.h"
 
 namespace jvl::direction {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) / kDeg;
-}
 
 // A VP that passed the forward filter.
 struct Candidate {

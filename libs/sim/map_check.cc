@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/check.h"
+#include "core/statistics.h"
 #include "core/threads.h"
 
 namespace jvl::sim {
@@ -12,14 +13,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Nearest-rank quantile (as the visual map statistics); NaN for no values.
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return kNaN;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1,
-                    static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
-}
 
 SurfaceDistanceStats Stats(const std::vector<SurfaceDistance>& distances, double min_depth,
                            double max_depth, double threshold) {

@@ -134,7 +134,7 @@ TEST_F(GlobalOptTest, ArtifactsAssembleToTheSameInput) {
   EXPECT_EQ(in.map_points.size(), syn_.input.map_points.size());
   EXPECT_EQ(in.directions.size(), syn_.input.directions.size() + 1);
   EXPECT_NEAR((in.scans[3].points[5] - syn_.input.scans[3].points[5]).norm(), 0.0, 1e-4);
-  const auto sel = mapping::SelectDirections(in.keyframes, in.directions);
+  const auto sel = direction::SelectDirections(in.keyframes, in.directions);
   EXPECT_EQ(sel.not_keyframe, 1);
 }
 

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
+#include <string>
 #include <unordered_set>
 
 #include "core/check.h"
@@ -18,22 +20,6 @@
 #include "lidar/voxel_grid.h"
 
 namespace jvl::mapping {
-
-namespace {
-
-double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
-}
-
-// Median (upper for even sizes); NaN if empty.
-double Median(std::vector<double> v) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
-}  // namespace
 
 void GlobalMapInput::Check() const {
   keyframes.Check("global input keyframes");
@@ -135,113 +121,12 @@ const char* ToString(GlobalMappingOptions::DirectionSource source) {
   return "?";
 }
 
-DirectionSelection SelectDirections(const Trajectory& keyframes,
-                                    const std::vector<DirectionAssociation>& associations) {
-  DirectionSelection out;
-  for (const auto& a : associations) {
-    const auto row = keyframes.IndexOf(a.frame);
-    if (!row) {
-      ++out.not_keyframe;
-      continue;
-    }
-    // A VP at infinity has no finite pixel v for Eq. (6); it is skipped (docs/global_opt.md).
-    if (!a.uv.allFinite()) {
-      ++out.at_infinity;
-      continue;
-    }
-    JVL_CHECK(a.direction_world.allFinite() && a.direction_world.norm() > 0.5,
-              "direction prior of cluster " << a.cluster << " (frame " << a.frame
-                                            << ") is not a unit vector");
-    out.constraints.push_back({static_cast<int64_t>(*row), a.uv, a.direction_world.normalized()});
-    out.clusters.push_back(a.cluster);
-  }
+std::vector<optim::DirectionConstraint> ToDirectionConstraints(
+    const std::vector<direction::VpPrior>& priors) {
+  std::vector<optim::DirectionConstraint> out;
+  out.reserve(priors.size());
+  for (const auto& p : priors) out.push_back({p.keyframe, p.vp, p.direction_world});
   return out;
-}
-
-DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera& camera,
-                               const DirectionSelection& selection, double outlier_deg,
-                               int min_support) {
-  JVL_CHECK(selection.clusters.size() == selection.constraints.size(),
-            "RefitDirections: " << selection.clusters.size() << " cluster ids for "
-                                << selection.constraints.size() << " constraints");
-  // World direction of every VP under the current rotation, oriented like the old d_w.
-  std::map<int32_t, std::vector<size_t>> members;
-  std::vector<Eigen::Vector3d> rays(selection.constraints.size());
-  for (size_t i = 0; i < selection.constraints.size(); ++i) {
-    const auto& c = selection.constraints[i];
-    JVL_CHECK(c.keyframe >= 0 && static_cast<size_t>(c.keyframe) < keyframes.size(),
-              "RefitDirections: keyframe row " << c.keyframe << " out of range");
-    const Eigen::Vector3d cam_ray = camera.Unproject(c.vp).normalized();
-    Eigen::Vector3d w = keyframes.world_from_cam[c.keyframe].rotation() * cam_ray;
-    if (w.dot(c.direction_world) < 0) w = -w;
-    rays[i] = w;
-    members[selection.clusters[i]].push_back(i);
-  }
-  DirectionRefit out;
-  out.selection.not_keyframe = selection.not_keyframe;
-  out.selection.at_infinity = selection.at_infinity;
-  for (const auto& [cluster, idx] : members) {
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    for (size_t i : idx) d += rays[i];
-    d.normalize();
-    // Robust mean: gate = max(outlier_deg, 3 sigma) with sigma from the median angle to the
-    // current mean (2D Gaussian: median = 1.1774 sigma); iterate to a fixed point.
-    std::vector<size_t> kept = idx;
-    for (int it = 0; it < 20; ++it) {
-      std::vector<double> angles;
-      for (size_t i : kept) angles.push_back(AngleDeg(rays[i], d));
-      const double median = Median(angles);
-      const double gate = std::max(outlier_deg, 3.0 * median / 1.1774);
-      std::vector<size_t> next;
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (size_t i : idx)
-        if (AngleDeg(rays[i], d) <= gate) {
-          next.push_back(i);
-          sum += rays[i];
-        }
-      if (next.empty()) {
-        kept.clear();
-        break;
-      }
-      const bool stable = next == kept;
-      kept = std::move(next);
-      d = sum.normalized();
-      if (stable) break;
-    }
-    out.outliers += static_cast<int64_t>(idx.size() - kept.size());
-    if (static_cast<int>(kept.size()) < min_support) {
-      out.small_cluster_vps += static_cast<int64_t>(kept.size());
-      continue;
-    }
-    out.directions[cluster] = d;
-    const Eigen::Vector3d old = selection.constraints[idx.front()].direction_world;
-    out.change_deg[cluster] = std::acos(std::clamp(old.dot(d), -1.0, 1.0)) * 180.0 / M_PI;
-    for (size_t i : kept) {
-      optim::DirectionConstraint c = selection.constraints[i];
-      c.direction_world = d;
-      out.selection.constraints.push_back(c);
-      out.selection.clusters.push_back(cluster);
-    }
-  }
-  return out;
-}
-
-double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
-                            const std::vector<optim::DirectionConstraint>& constraints,
-                            const std::vector<Eigen::Vector3d>& free_directions) {
-  std::vector<double> e;
-  e.reserve(constraints.size());
-  for (const auto& c : constraints) {
-    const Eigen::Vector3d& d_w =
-        c.free_direction >= 0 ? free_directions.at(static_cast<size_t>(c.free_direction))
-                              : c.direction_world;
-    Eigen::Vector3d d =
-        keyframes.world_from_cam.at(static_cast<size_t>(c.keyframe)).rotation().inverse() * d_w;
-    if (d.z() < 0) d = -d;  // unoriented, as in the cost
-    if (d.z() < 1e-6) continue;
-    e.push_back((camera.Project(d) - c.vp).norm());
-  }
-  return Median(std::move(e));
 }
 
 namespace {
@@ -341,37 +226,221 @@ std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
 
 namespace {
 
-// The direction constraints of the first round with e_D: as selected (kPrior), with re-estimated
-// fixed d_w (kRefit) or with one free d_w block per cluster initialised by the re-estimate
-// (kFree); VPs far from their cluster's direction are dropped in both re-estimated forms.
-void PrepareDirections(const Trajectory& keyframes, const PinholeCamera& camera,
-                       const DirectionSelection& dirs, const GlobalMappingOptions& options,
-                       optim::JointProblemInput* problem, GlobalMappingResult* result) {
+// What stays the same over the rounds of Eq. (7).
+struct FixedTerms {
+  direction::DirectionSelection directions;  // e_D's priors as selected from the artifact
+  bool aggregate = false;     // e_L summed per keyframe pair (compressed form)
+  bool summed_saved = false;  // the saved set L given to the problem summed per pair
+  std::vector<optim::ImlsPair> saved_pairs;  // summed_saved: L summed per keyframe pair
+  int64_t saved_count = 0;                   // correspondences in L
+  bool fresh = false;                        // a fresh traversal in every round
+  int rounds = 1;
+};
+
+// e_D once it has entered the problem (GlobalMappingOptions::first_direction_round).
+struct DirectionTerm {
+  bool entered = false;
+  std::vector<direction::VpPrior> priors;  // d_w as it was when e_D entered
+  std::vector<optim::DirectionConstraint> constraints;
+  std::vector<Eigen::Vector3d> free_directions;  // kFree: current d_w of each kept cluster
+};
+
+// e_V (Eq. 5): the subset of the map points of GlobalMappingOptions::points_per_keyframe.
+void SelectVisualTerm(const GlobalMappingOptions& options, GlobalMapInput* input,
+                      GlobalMappingResult* result) {
+  result->input_observations = static_cast<int64_t>(input->observations.size());
+  result->input_points = static_cast<int64_t>(input->map_points.size());
+  result->selected_points = SelectObservations(&input->observations, input->map_points.size(),
+                                               options.points_per_keyframe);
+  result->selected_observations = static_cast<int64_t>(input->observations.size());
+  if (options.points_per_keyframe > 0) {
+    spdlog::info("visual term: {} of {} map points ({} of {} observations), at least {} per "
+                 "keyframe",
+                 result->selected_points, result->input_points, result->selected_observations,
+                 result->input_observations, options.points_per_keyframe);
+  }
+}
+
+FixedTerms PrepareFixedTerms(const GlobalMapInput& input, const GlobalMappingOptions& options,
+                             GlobalMappingResult* result) {
+  FixedTerms t;
+  t.directions = direction::SelectDirections(input.keyframes, input.directions);
+  result->directions_not_keyframe = t.directions.not_keyframe;
+  result->directions_at_infinity = t.directions.at_infinity;
+  if (options.use_directions)
+    result->directions_used = static_cast<int64_t>(t.directions.priors.size());
+  t.fresh = options.fresh_traversal && !input.scans.empty();
+  t.rounds = t.fresh ? options.rounds : 1;
+  // The saved set L does not change between rounds: summed per keyframe pair once (exact, see
+  // optim/imls_pair_cost.h) instead of copying millions of correspondences into every round.
+  t.aggregate = options.joint.SumsImlsPerPair();
+  t.summed_saved = options.use_saved_imls && t.aggregate;
+  JVL_CHECK(input.saved_imls_pairs.empty() || !options.use_saved_imls || t.summed_saved,
+            "the saved IMLS set is given summed per keyframe pair, which needs the compressed "
+            "e_L form (no Huber kernel on e_L)");
+  if (t.summed_saved) {
+    t.saved_pairs = optim::AggregateImls(input.saved_imls);
+    t.saved_pairs.insert(t.saved_pairs.end(), input.saved_imls_pairs.begin(),
+                         input.saved_imls_pairs.end());
+  }
+  t.saved_count = static_cast<int64_t>(input.saved_imls.size());
+  for (const auto& p : input.saved_imls_pairs) t.saved_count += p.sum.count();
+  return t;
+}
+
+// The direction constraints when e_D enters: as selected (kPrior), with re-estimated fixed d_w
+// (kRefit) or with one free d_w block per cluster initialised by the re-estimate (kFree); VPs
+// far from their cluster's direction are dropped in both re-estimated forms.
+void EnterDirections(const Trajectory& keyframes, const PinholeCamera& camera,
+                     const direction::DirectionSelection& dirs,
+                     const GlobalMappingOptions& options, DirectionTerm* term,
+                     GlobalMappingResult* result) {
   using Source = GlobalMappingOptions::DirectionSource;
-  problem->free_directions.clear();
+  term->entered = true;
   if (options.direction_source == Source::kPrior) {
-    problem->directions = dirs.constraints;
+    term->priors = dirs.priors;
+    term->constraints = ToDirectionConstraints(term->priors);
     return;
   }
-  const DirectionRefit refit = RefitDirections(keyframes, camera, dirs, options.refit_outlier_deg,
-                                               options.refit_min_support);
-  problem->directions = refit.selection.constraints;
+  const direction::DirectionRefit refit = direction::RefitDirections(
+      keyframes, camera, dirs, options.refit_outlier_deg, options.refit_min_support);
+  term->priors = refit.selection.priors;
+  term->constraints = ToDirectionConstraints(term->priors);
   result->directions_outliers = refit.outliers;
   result->directions_small_cluster = refit.small_cluster_vps;
   result->direction_change_deg = refit.change_deg;
-  result->directions_used = static_cast<int64_t>(problem->directions.size());
+  result->directions_used = static_cast<int64_t>(term->constraints.size());
   for (const auto& [cluster, change] : refit.change_deg)
     spdlog::debug("direction prior of cluster {} re-estimated: moved {:.3f} deg", cluster, change);
   if (options.direction_source != Source::kFree) return;
   std::map<int32_t, int32_t> block_of;
   result->free_direction_clusters.clear();
   for (const auto& [cluster, d] : refit.directions) {
-    block_of[cluster] = static_cast<int32_t>(problem->free_directions.size());
-    problem->free_directions.push_back(d);
+    block_of[cluster] = static_cast<int32_t>(term->free_directions.size());
+    term->free_directions.push_back(d);
     result->free_direction_clusters.push_back(cluster);
   }
-  for (size_t i = 0; i < problem->directions.size(); ++i)
-    problem->directions[i].free_direction = block_of.at(refit.selection.clusters[i]);
+  for (size_t i = 0; i < term->constraints.size(); ++i)
+    term->constraints[i].free_direction = block_of.at(refit.selection.clusters[i]);
+}
+
+// sigma of e_D: given, or estimated where e_D enters from the median |e_D| (2D Gaussian: median
+// |e| = sigma sqrt(2 ln 2)). Measured at the warm-started poses, so it also holds what is left
+// of the drift: an upper bound of the VP noise.
+void SetDirectionSigma(const Trajectory& keyframes, const PinholeCamera& camera,
+                       const DirectionTerm& term, const GlobalMappingOptions& options,
+                       GlobalMappingResult* result) {
+  if (options.direction_sigma_px > 0) {
+    result->direction_sigma_px = options.direction_sigma_px;
+    return;
+  }
+  const double sigma =
+      direction::MedianDirectionError(keyframes, camera, term.priors) / std::sqrt(2.0 * M_LN2);
+  result->direction_sigma_px =
+      std::isfinite(sigma) ? std::max(options.min_direction_sigma_px, sigma) : 1.0;
+  result->direction_sigma_estimated = true;
+  spdlog::debug("e_D sigma estimated: {:.3f} px", result->direction_sigma_px);
+}
+
+// e_D (Eq. 6) of this round: left out before GlobalMappingOptions::first_direction_round.
+void SetDirectionTerm(int round, const FixedTerms& terms, const PinholeCamera& camera,
+                      const GlobalMappingOptions& options, DirectionTerm* term,
+                      optim::JointProblemOptions* joint, optim::JointProblemInput* problem,
+                      GlobalMappingResult* result) {
+  problem->directions.clear();
+  problem->free_directions.clear();
+  if (!options.use_directions || round < std::min(options.first_direction_round, terms.rounds - 1))
+    return;
+  if (!term->entered) {
+    EnterDirections(result->keyframes, camera, terms.directions, options, term, result);
+    SetDirectionSigma(result->keyframes, camera, *term, options, result);
+    joint->direction_sigma_px = result->direction_sigma_px;
+  }
+  problem->directions = term->constraints;
+  problem->free_directions = term->free_directions;
+}
+
+// e_L (Eq. 3-4) of this round: the saved set L and, with a fresh traversal, Eq. (3) against the
+// current poses (the paper's single traversal in round 0). The scans are released after the
+// last traversal (on a long sequence they are a large part of the memory).
+void SetImlsTerm(int round, const FixedTerms& terms, const GlobalMappingOptions& options,
+                 GlobalMapInput* input, optim::JointProblemInput* problem,
+                 GlobalMappingResult* result) {
+  problem->imls.clear();
+  problem->imls_pairs.clear();
+  if (options.use_saved_imls) {
+    if (terms.summed_saved) {
+      problem->imls_pairs = terms.saved_pairs;
+    } else {
+      problem->imls = input->saved_imls;
+    }
+    result->saved_imls = terms.saved_count;
+  }
+  if (!terms.fresh) return;
+  const Timer t;
+  const auto l =
+      TraverseImls(result->keyframes, input->scans, options.traversal, options.solve.threads);
+  if (terms.aggregate) {  // kept summed as well (the raw list is not needed for the solve)
+    const auto fresh_pairs = optim::AggregateImls(l);
+    problem->imls_pairs.insert(problem->imls_pairs.end(), fresh_pairs.begin(), fresh_pairs.end());
+  } else {
+    problem->imls.insert(problem->imls.end(), l.begin(), l.end());
+  }
+  result->fresh_imls = static_cast<int64_t>(l.size());
+  result->traversal_time_s += t.ElapsedSeconds();
+  spdlog::debug("round {}: fresh IMLS traversal {:.1f} s ({} correspondences)", round + 1,
+                t.ElapsedSeconds(), l.size());
+  if (round == terms.rounds - 1) std::vector<lidar::StoredScan>().swap(input->scans);
+}
+
+// The report's "before" is the full energy at the input poses. When round 0 warm-starts without
+// e_D, e_D's part is evaluated on its own with the weights the full problem would have (no
+// second copy of the large terms).
+std::optional<optim::ResidualStats> DirectionCostBefore(int round, const FixedTerms& terms,
+                                                        const optim::JointProblemInput& problem,
+                                                        const optim::JointProblemOptions& joint,
+                                                        const GlobalMappingOptions& options) {
+  if (round != 0 || !options.use_directions || !problem.directions.empty() ||
+      terms.directions.priors.empty())
+    return std::nullopt;
+  optim::JointProblemInput only;
+  only.camera = problem.camera;
+  only.poses = problem.poses;
+  only.fixed = problem.fixed;
+  only.directions = ToDirectionConstraints(terms.directions.priors);
+  const optim::JointWeights w =
+      optim::ResolveWeights(joint, static_cast<int64_t>(problem.Observations().size()),
+                            optim::CountImls(problem), static_cast<int64_t>(only.directions.size()));
+  optim::JointProblemOptions o = joint;
+  o.alpha = w.alpha;
+  o.beta = w.beta;
+  o.gamma = w.gamma;
+  auto built = optim::BuildJointProblem(only, o);
+  return optim::EvaluateJointCost(built).direction;
+}
+
+// One Levenberg-Marquardt solve of the round's problem; only round 0's costs before and the
+// last round's after are evaluated (they are what the report gives).
+optim::JointSolveResult SolveRound(int round, int rounds, const optim::JointProblemInput& problem,
+                                   const optim::JointProblemOptions& joint,
+                                   optim::SolveOptions solve) {
+  if (!solve.progress_label.empty())
+    solve.progress_label += " round " + std::to_string(round + 1) + "/" + std::to_string(rounds);
+  solve.evaluate_before = round == 0;
+  solve.evaluate_after = round == rounds - 1;
+  return optim::OptimizeJoint(problem, joint, solve);
+}
+
+// The round's solution is the next round's start.
+void AcceptRound(DirectionTerm* direction, optim::JointProblemInput* problem,
+                 GlobalMappingResult* result) {
+  for (size_t i = 0; i < result->keyframes.size(); ++i)
+    result->keyframes.world_from_cam[i] = result->solve.poses.at(static_cast<int64_t>(i));
+  problem->map_points = result->solve.map_points;
+  if (!direction->free_directions.empty()) {
+    direction->free_directions = result->solve.free_directions;
+    result->free_directions = direction->free_directions;
+  }
 }
 
 }  // namespace
@@ -381,163 +450,43 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   options.Check();
   input.Check();
   GlobalMappingResult result;
+  result.keyframes = input.keyframes;
+  SelectVisualTerm(options, &input, &result);
+  const FixedTerms terms = PrepareFixedTerms(input, options, &result);
   optim::JointProblemInput problem;
   problem.camera = input.camera;
   problem.fixed = {0};  // gauge: the first keyframe
   problem.map_points = input.map_points;
-  result.input_observations = static_cast<int64_t>(input.observations.size());
-  result.input_points = static_cast<int64_t>(input.map_points.size());
-  result.selected_points = SelectObservations(&input.observations, input.map_points.size(),
-                                              options.points_per_keyframe);
-  result.selected_observations = static_cast<int64_t>(input.observations.size());
-  if (options.points_per_keyframe > 0) {
-    spdlog::info("visual term: {} of {} map points ({} of {} observations), at least {} per "
-                 "keyframe",
-                 result.selected_points, result.input_points, result.selected_observations,
-                 result.input_observations, options.points_per_keyframe);
-  }
   problem.shared_observations = &input.observations;
-  const DirectionSelection dirs = SelectDirections(input.keyframes, input.directions);
-  result.directions_not_keyframe = dirs.not_keyframe;
-  result.directions_at_infinity = dirs.at_infinity;
-  if (options.use_directions)
-    result.directions_used = static_cast<int64_t>(dirs.constraints.size());
-  result.keyframes = input.keyframes;
-  const bool fresh = options.fresh_traversal && !input.scans.empty();
-  const int rounds = fresh ? options.rounds : 1;
-  std::vector<optim::DirectionConstraint> active;  // e_D's constraints once they enter
-  std::vector<Eigen::Vector3d> free_directions;   // DirectionSource::kFree: current d_w
-  bool refitted = false;
   optim::JointProblemOptions joint = options.joint;  // direction sigma set once e_D enters
-  optim::JointCostBreakdown first_before;
-  // The saved set L does not change between rounds: summed per keyframe pair once (exact, see
-  // optim/imls_pair_cost.h) instead of copying millions of correspondences into every round.
-  const bool aggregate = options.joint.SumsImlsPerPair();
-  const bool summed_saved = options.use_saved_imls && aggregate;
-  JVL_CHECK(input.saved_imls_pairs.empty() || !options.use_saved_imls || summed_saved,
-            "the saved IMLS set is given summed per keyframe pair, which needs the compressed "
-            "e_L form (no Huber kernel on e_L)");
-  std::vector<optim::ImlsPair> saved_pairs;
-  if (summed_saved) {
-    saved_pairs = optim::AggregateImls(input.saved_imls);
-    saved_pairs.insert(saved_pairs.end(), input.saved_imls_pairs.begin(),
-                       input.saved_imls_pairs.end());
-  }
-  int64_t saved_count = static_cast<int64_t>(input.saved_imls.size());
-  for (const auto& p : input.saved_imls_pairs) saved_count += p.sum.count();
-  for (int round = 0; round < rounds; ++round) {
+  DirectionTerm direction;
+  optim::JointCostBreakdown before;  // Eq. (7) at the input poses
+  for (int round = 0; round < terms.rounds; ++round) {
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
-    problem.directions.clear();
-    if (options.use_directions && round >= std::min(options.first_direction_round, rounds - 1)) {
-      if (!refitted) {
-        PrepareDirections(result.keyframes, input.camera, dirs, options, &problem, &result);
-        active = problem.directions;
-        free_directions = problem.free_directions;
-        refitted = true;
-        if (options.direction_sigma_px > 0) {
-          result.direction_sigma_px = options.direction_sigma_px;
-        } else {
-          // 2D Gaussian: median |e| = sigma sqrt(2 ln 2). Measured at the warm-started poses, so
-          // it also holds what is left of the drift: an upper bound of the VP noise.
-          const double sigma =
-              MedianDirectionError(result.keyframes, input.camera, active, free_directions) /
-              std::sqrt(2.0 * M_LN2);
-          result.direction_sigma_px = std::isfinite(sigma)
-                                          ? std::max(options.min_direction_sigma_px, sigma)
-                                          : 1.0;
-          result.direction_sigma_estimated = true;
-          spdlog::debug("e_D sigma estimated: {:.3f} px", result.direction_sigma_px);
-        }
-        joint.direction_sigma_px = result.direction_sigma_px;
-      }
-      problem.directions = active;
-      problem.free_directions = free_directions;
-    }
-    problem.imls.clear();
-    problem.imls_pairs.clear();
-    if (options.use_saved_imls) {
-      if (summed_saved) {
-        problem.imls_pairs = saved_pairs;
-      } else {
-        problem.imls = input.saved_imls;
-      }
-      result.saved_imls = saved_count;
-    }
-    if (fresh) {
-      // Eq. (3) against the current poses (the paper's single traversal in round 0).
-      const Timer t;
-      const auto l =
-          TraverseImls(result.keyframes, input.scans, options.traversal, options.solve.threads);
-      if (aggregate) {  // kept summed as well (the raw list is not needed for the solve)
-        const auto fresh_pairs = optim::AggregateImls(l);
-        problem.imls_pairs.insert(problem.imls_pairs.end(), fresh_pairs.begin(),
-                                  fresh_pairs.end());
-      } else {
-        problem.imls.insert(problem.imls.end(), l.begin(), l.end());
-      }
-      result.fresh_imls = static_cast<int64_t>(l.size());
-      result.traversal_time_s += t.ElapsedSeconds();
-      spdlog::debug("round {}: fresh IMLS traversal {:.1f} s ({} correspondences)", round + 1,
-                    t.ElapsedSeconds(), l.size());
-      if (round == rounds - 1) std::vector<lidar::StoredScan>().swap(input.scans);  // not needed now
-    }
-    // Warm-start round without e_D: the report's "before" is still the full energy at the input
-    // poses. Its visual and IMLS parts are this round's; e_D's part is evaluated on its own with
-    // the weights the full problem would have (no second copy of the large terms).
-    const bool add_direction_before =
-        round == 0 && options.use_directions && problem.directions.empty() &&
-        !dirs.constraints.empty();
-    optim::ResidualStats direction_before;
-    if (add_direction_before) {
-      optim::JointProblemInput only;
-      only.camera = problem.camera;
-      only.poses = problem.poses;
-      only.fixed = problem.fixed;
-      only.directions = dirs.constraints;
-      const optim::JointWeights w = optim::ResolveWeights(
-          joint, static_cast<int64_t>(problem.Observations().size()),
-          optim::CountImls(problem), static_cast<int64_t>(dirs.constraints.size()));
-      optim::JointProblemOptions o = joint;
-      o.alpha = w.alpha;
-      o.beta = w.beta;
-      o.gamma = w.gamma;
-      auto built = optim::BuildJointProblem(only, o);
-      direction_before = optim::EvaluateJointCost(built).direction;
-    }
-    optim::SolveOptions solve = options.solve;
-    if (!solve.progress_label.empty())
-      solve.progress_label += " round " + std::to_string(round + 1) + "/" + std::to_string(rounds);
-    // Only round 0's costs before and the last round's after are reported.
-    solve.evaluate_before = round == 0;
-    solve.evaluate_after = round == rounds - 1;
-    result.solve = optim::OptimizeJoint(problem, joint, solve);
+    SetDirectionTerm(round, terms, input.camera, options, &direction, &joint, &problem, &result);
+    SetImlsTerm(round, terms, options, &input, &problem, &result);
+    const auto direction_before = DirectionCostBefore(round, terms, problem, joint, options);
+    result.solve = SolveRound(round, terms.rounds, problem, joint, options.solve);
     ReleaseFreeHeapMemory();  // the round's Ceres problem is gone (core/memory.h)
     ++result.rounds;
     result.total_iterations += result.solve.iterations;
     if (round == 0) {
-      first_before = result.solve.before;
-      if (add_direction_before) {
-        first_before.direction = direction_before;
-        first_before.total += direction_before.cost;
+      before = result.solve.before;
+      if (direction_before) {
+        before.direction = *direction_before;
+        before.total += direction_before->cost;
       }
     }
     if (!result.solve.usable) {
-      spdlog::warn(
-          "global optimisation round {} failed ({}); keyframes keep the poses of the "
-          "previous round",
-          round, result.solve.termination);
+      spdlog::warn("global optimisation round {} failed ({}); keyframes keep the poses of the "
+                   "previous round",
+                   round, result.solve.termination);
       break;
     }
-    for (size_t i = 0; i < result.keyframes.size(); ++i)
-      result.keyframes.world_from_cam[i] = result.solve.poses.at(static_cast<int64_t>(i));
-    problem.map_points = result.solve.map_points;
-    if (!problem.free_directions.empty()) {
-      free_directions = result.solve.free_directions;
-      result.free_directions = free_directions;
-    }
+    AcceptRound(&direction, &problem, &result);
   }
-  result.solve.before = first_before;  // report the costs at the input poses
+  result.solve.before = before;  // report the costs at the input poses
   result.total_time_s = total.ElapsedSeconds();
   return result;
 }

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "direction/vp_priors.h"
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
 #include "geometry/trajectory.h"
@@ -25,14 +26,6 @@
 #include "optim/joint_problem.h"
 
 namespace jvl::mapping {
-
-// A VP of a frame associated with a direction prior d_w (directions artifact).
-struct DirectionAssociation {
-  int64_t frame = 0;
-  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // Pixels; NaN if the VP is at infinity.
-  Eigen::Vector3d direction_world = Eigen::Vector3d::UnitZ();
-  int32_t cluster = 0;
-};
 
 // Everything the global problem needs; keyframe references are rows of `keyframes`.
 struct GlobalMapInput {
@@ -46,7 +39,7 @@ struct GlobalMapInput {
   // e_L form (JointProblemOptions::compress_imls, no Huber kernel on e_L).
   std::vector<optim::ImlsPair> saved_imls_pairs;
   std::vector<lidar::StoredScan> scans;                     // One per keyframe row (may be empty).
-  std::vector<DirectionAssociation> directions;        // Any frames; non-keyframes skipped.
+  std::vector<direction::DirectionAssociation> directions;  // Any frames; non-keyframes skipped.
   void Check() const;
 };
 
@@ -77,14 +70,14 @@ struct GlobalMappingOptions {
   //  - kPrior: the directions artifact (direction_cluster's d_w, i.e. the prior's rotations;
   //    the paper's supplement 1.4);
   //  - kRefit: re-estimated per cluster from the current keyframe rotations (after the warm-start
-  //    rounds) as the robust mean of the back-projected VPs R_wn K^-1 v (RefitDirections; far
+  //    rounds) as the robust mean of the back-projected VPs R_wn K^-1 v (direction::RefitDirections; far
   //    VPs are dropped), then fixed;
   //  - kFree: as kRefit, but each cluster's d_w is then a free unit-vector block optimised
   //    with the poses (a landmark at infinity), so that the gauge keyframe and the other terms
   //    fix its absolute orientation and e_D only makes the cluster's keyframes agree.
   enum class DirectionSource { kPrior, kRefit, kFree };
   DirectionSource direction_source = DirectionSource::kFree;
-  double refit_outlier_deg = 1.0;  // smallest outlier gate (see RefitDirections)
+  double refit_outlier_deg = 1.0;  // smallest outlier gate (direction::RefitDirections)
   int refit_min_support = 3;  // clusters with fewer inlier keyframes are left out
   // sigma of e_D in pixels (its whitening, see JointProblemOptions::direction_sigma_px).
   // <= 0: estimated when e_D enters the problem from the median of |v - pi(R_nw d_w)| at the
@@ -97,22 +90,6 @@ struct GlobalMappingOptions {
   // free-map-point solve grows with the observations. 0 = every point.
   int points_per_keyframe = 0;
   void Check() const;
-};
-
-struct DirectionSelection {
-  std::vector<optim::DirectionConstraint> constraints;  // keyframe = row.
-  std::vector<int32_t> clusters;                        // cluster of each constraint
-  int64_t not_keyframe = 0;  // Associations of frames that are not keyframes.
-  int64_t at_infinity = 0;   // Non-finite VP (skipped: e_D needs a finite v).
-};
-
-// Direction priors re-estimated from the current keyframe rotations (DirectionSource::kRefit).
-struct DirectionRefit {
-  DirectionSelection selection;                 // inliers with their cluster's new d_w
-  std::map<int32_t, Eigen::Vector3d> directions;  // cluster -> re-estimated d_w (kept clusters)
-  std::map<int32_t, double> change_deg;           // cluster -> angle(old d_w, new d_w)
-  int64_t outliers = 0;            // VPs further than the threshold from their cluster
-  int64_t small_cluster_vps = 0;   // VPs of clusters left with < min_support inliers
 };
 
 struct GlobalMappingResult {
@@ -137,25 +114,10 @@ struct GlobalMappingResult {
   int64_t input_points = 0, selected_points = 0;
 };
 
-// Direction residual inputs: one per keyframe with an association and a finite VP.
-DirectionSelection SelectDirections(const Trajectory& keyframes,
-                                    const std::vector<DirectionAssociation>& associations);
-
-// Re-estimates d_w of every cluster from the rotations of `keyframes` (rows as in `selection`):
-// each VP v of keyframe n gives the world direction R_wn K^-1 v (sign of the old d_w); d_w is
-// their mean over the VPs within a gate of max(outlier_deg, 3 sigma) of it, sigma from the
-// median angle (iterated to a fixed point; drops the VPs of turn exits and mismatched lines).
-// Clusters with fewer than `min_support` inliers are dropped.
-DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera& camera,
-                               const DirectionSelection& selection, double outlier_deg,
-                               int min_support);
-
-// Median of |v - pi(R_nw d_w)| (pixels) over `constraints` at the rows' poses of `keyframes`
-// (NaN if empty; d_w of a free constraint from `free_directions`); directions behind the camera
-// are skipped.
-double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
-                            const std::vector<optim::DirectionConstraint>& constraints,
-                            const std::vector<Eigen::Vector3d>& free_directions = {});
+// The e_D residuals of `priors` (fixed d_w; the selection and re-estimation of the priors are
+// jvl::direction's, direction/vp_priors.h).
+std::vector<optim::DirectionConstraint> ToDirectionConstraints(
+    const std::vector<direction::VpPrior>& priors);
 
 const char* ToString(GlobalMappingOptions::DirectionSource source);
 

@@ -29,71 +29,6 @@ GlobalMappingOptions Quiet() {
   return o;
 }
 
-TEST(GlobalMapping, SelectDirectionsSkipsNonKeyframesAndVpsAtInfinity) {
-  Trajectory kf;
-  kf.Append(10, Rigid3d());
-  kf.Append(20, Rigid3d());
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  const auto sel = SelectDirections(kf, {{20, {600, 180}, {0, 0, 1}, 3},
-                                         {15, {600, 180}, {0, 0, 1}, 3},
-                                         {10, {nan, nan}, {0, 0, 1}, 3}});
-  ASSERT_EQ(sel.constraints.size(), 1u);
-  EXPECT_EQ(sel.constraints[0].keyframe, 1);  // row of frame 20
-  EXPECT_EQ(sel.not_keyframe, 1);
-  EXPECT_EQ(sel.at_infinity, 1);
-}
-
-// Keyframes turning slowly in yaw, each seeing the same world direction d (with pixel noise).
-struct RefitCase {
-  Trajectory keyframes;
-  DirectionSelection selection;
-  Eigen::Vector3d truth;
-};
-
-RefitCase MakeRefitCase(int n, double noise_px, double old_error_deg, uint32_t seed) {
-  RefitCase rc;
-  const PinholeCamera camera = testing::SyntheticCamera();
-  rc.truth = Eigen::Vector3d(0.02, 0.01, 1).normalized();
-  const Eigen::Vector3d old =
-      ExpSO3(Eigen::Vector3d(0, old_error_deg * M_PI / 180.0, 0)) * rc.truth;
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> g(0.0, noise_px);
-  for (int i = 0; i < n; ++i) {
-    const Rigid3d pose(ExpSO3(Eigen::Vector3d(0.001 * i, 0.004 * i, 0)),
-                       Eigen::Vector3d(0, 0, 2.0 * i));
-    rc.keyframes.Append(i, pose);
-    const Eigen::Vector2d v = camera.Project(pose.rotation().conjugate() * rc.truth) +
-                              Eigen::Vector2d(g(rng), g(rng));
-    rc.selection.constraints.push_back({i, v, old});
-    rc.selection.clusters.push_back(4);
-  }
-  return rc;
-}
-
-// The re-estimated d_w follows the current rotations, not the old (prior) direction, and VPs of
-// another direction (turn exit) are dropped.
-TEST(GlobalMapping, RefitDirectionsFollowsTheRotationsAndDropsOutliers) {
-  RefitCase rc = MakeRefitCase(40, 1.0, 1.5, 3);
-  const PinholeCamera camera = testing::SyntheticCamera();
-  for (int i : {5, 30}) {  // 5 deg off in yaw
-    const Eigen::Vector3d off = ExpSO3(Eigen::Vector3d(0, 5 * M_PI / 180.0, 0)) * rc.truth;
-    rc.selection.constraints[i].vp =
-        camera.Project(rc.keyframes.world_from_cam[i].rotation().conjugate() * off);
-  }
-  const DirectionRefit r = RefitDirections(rc.keyframes, camera, rc.selection, 1.0, 3);
-  EXPECT_EQ(r.outliers, 2);
-  ASSERT_EQ(r.directions.count(4), 1u);
-  const double err = std::acos(std::min(1.0, r.directions.at(4).dot(rc.truth))) * 180 / M_PI;
-  EXPECT_LT(err, 0.05);
-  EXPECT_NEAR(r.change_deg.at(4), 1.5, 0.1);
-  ASSERT_EQ(r.selection.constraints.size(), 38u);
-  for (const auto& c : r.selection.constraints) EXPECT_EQ(c.direction_world, r.directions.at(4));
-  // Too little support: the cluster is left out.
-  const DirectionRefit few = RefitDirections(rc.keyframes, camera, rc.selection, 1.0, 39);
-  EXPECT_TRUE(few.selection.constraints.empty());
-  EXPECT_EQ(few.small_cluster_vps, 38);
-}
-
 // Problem level: e_D is zero when R_nw d_w projects onto v, its derivative w.r.t. the translation
 // is zero and the tangent Jacobian matches central differences on the manifold.
 TEST(GlobalMapping, DirectionResidualInTheAssembledProblem) {
@@ -105,11 +40,11 @@ TEST(GlobalMapping, DirectionResidualInTheAssembledProblem) {
   const Eigen::Vector3d d_w = Eigen::Vector3d(0.1, 0.02, 1).normalized();
   const Eigen::Vector2d v = in.camera.Project(pose.rotation().conjugate() * d_w);
   in.directions.push_back({5, v, d_w, 0});
-  const auto sel = SelectDirections(in.keyframes, in.directions);
+  const auto sel = direction::SelectDirections(in.keyframes, in.directions);
   optim::JointProblemInput p;
   p.camera = in.camera;
   p.poses = {{0, in.keyframes.world_from_cam[0]}, {1, pose}};
-  p.directions = sel.constraints;
+  p.directions = ToDirectionConstraints(sel.priors);
   auto problem = optim::BuildJointProblem(p, {});
   ASSERT_EQ(problem.direction_blocks.size(), 1u);
   double* block = problem.poses.at(1).data();

@@ -1,18 +1,18 @@
 // Results of local mapping as plain values: the refined keyframes and the run summary.
-#include <algorithm>
+#include <utility>
 
+#include "core/statistics.h"
 #include "mapping/local/local_mapping.h"
 
 namespace jvl::mapping {
 namespace {
 
+// Nearest-rank quantile of one field over the keyframes; 0 for none.
 template <typename T, typename F>
 double Quantile(const std::vector<T>& items, double q, F&& get) {
   std::vector<double> v;
   for (const T& item : items) v.push_back(static_cast<double>(get(item)));
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
+  return v.empty() ? 0.0 : jvl::Quantile(std::move(v), q);
 }
 
 

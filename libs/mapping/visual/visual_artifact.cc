@@ -5,21 +5,16 @@
 #include <map>
 
 #include "core/check.h"
+#include "core/statistics.h"
 
 namespace jvl::mapping {
 namespace {
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+// The summaries report 0 for an empty sample (the artifact's statistics are numbers).
+double MedianOrZero(const std::vector<double>& v) { return v.empty() ? 0.0 : Median(v); }
 
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5))];
+double QuantileOrZero(const std::vector<double>& v, double q) {
+  return v.empty() ? 0.0 : Quantile(v, q);
 }
 
 }  // namespace
@@ -57,9 +52,9 @@ nlohmann::json Summarize(const VisualMapResult& result, const VisualMapStats& st
   j["mean_observations_per_point"] = stats.mean_observations_per_point;
   j["median_reprojection_px"] = stats.median_reprojection_px;
   j["p90_reprojection_px"] = stats.p90_reprojection_px;
-  j["median_frame_ms"] = Median(total_ms);
-  j["median_association_ms"] = Median(assoc_ms);
-  j["median_orb_ms"] = Median(result.orb_ms);
+  j["median_frame_ms"] = MedianOrZero(total_ms);
+  j["median_association_ms"] = MedianOrZero(assoc_ms);
+  j["median_orb_ms"] = MedianOrZero(result.orb_ms);
   return j;
 }
 
@@ -149,11 +144,11 @@ VisualMapStats ComputeStats(const io::VisualMapData& d) {
     const Eigen::Vector2d uv(d.keypoint_uv[2 * kp], d.keypoint_uv[2 * kp + 1]);
     errors.push_back(pc.z() > 0 ? (d.camera.Project(pc) - uv).norm() : 1e9);
   }
-  s.median_points_per_keyframe = Median(per_kf);
+  s.median_points_per_keyframe = MedianOrZero(per_kf);
   s.min_points_per_keyframe = per_kf.empty() ? 0 : *std::min_element(per_kf.begin(), per_kf.end());
   s.mean_observations_per_point = s.mappoints ? double(s.observations) / s.mappoints : 0.0;
-  s.median_reprojection_px = Median(errors);
-  s.p90_reprojection_px = Quantile(errors, 0.9);
+  s.median_reprojection_px = MedianOrZero(errors);
+  s.p90_reprojection_px = QuantileOrZero(errors, 0.9);
   return s;
 }
 
