@@ -22,15 +22,7 @@ int main(int argc, char** argv) {
   std::string local_path, visual_path, directions_path, prior_path, output, kitti, map_path;
   double map_voxel = 0.2;
   bool no_direction = false, map_ascii = false, no_saved = false, no_fresh = false;
-  mapping::GlobalMappingOptions o;
-  // Defaults for local_map output (map points consistent with the keyframe poses), which is what
-  // this tool reads; the library's defaults keep every observation and point free. They make the
-  // free-map-point solve converge and fit the time budget on long sequences (docs/global_opt.md,
-  // "Default configuration").
-  o.joint.visual_gate_chi2 = 5.991;      // chi2(2, 0.95)
-  o.joint.max_point_sigma_ratio = 0.3;   // hold poorly determined points
-  o.points_per_keyframe = 200;           // visual term on the longest tracks
-  o.solve.function_tolerance = 1e-5;     // the last 1e-5 of the cost does not move the poses
+  mapping::GlobalMappingOptions o;  // the library's defaults are the tool's
   auto& cli = tool.cli();
   tool.InputFile(cli.add_option("--local", local_path, "local artifact (local_map)")->required());
   tool.InputFile(
@@ -69,7 +61,7 @@ int main(int argc, char** argv) {
   cli.add_option("--first-direction-round", o.first_direction_round,
                  "Rounds before this one run without e_D (warm start; 0 = e_D in every round)")
       ->capture_default_str();
-  std::string direction_source = "free";
+  std::string direction_source = mapping::ToString(o.direction_source);
   cli.add_option("--direction-source", direction_source,
                  "d_w of e_D: 'free' re-estimates each cluster's direction from the rotations "
                  "after the warm-start round (robust mean, outlier VPs dropped) and optimises it "

@@ -49,6 +49,28 @@ void ImlsTraversalOptions::Check() const {
   association.Check();
 }
 
+optim::JointProblemOptions DefaultGlobalJointOptions() {
+  optim::JointProblemOptions o;
+  o.visual_gate_chi2 = 5.991;     // chi2(2, 0.95)
+  o.max_point_sigma_ratio = 0.3;  // hold poorly determined points
+  return o;
+}
+
+optim::SolveOptions DefaultGlobalSolveOptions() {
+  optim::SolveOptions o;
+  o.function_tolerance = 1e-5;  // the last 1e-5 of the cost does not move the poses
+  return o;
+}
+
+GlobalMappingOptions GlobalMappingOptions::EveryObservation() {
+  GlobalMappingOptions o;
+  o.joint.visual_gate_chi2 = 0;
+  o.joint.max_point_sigma_ratio = 0;
+  o.points_per_keyframe = 0;
+  o.solve.function_tolerance = 1e-6;
+  return o;
+}
+
 void GlobalMappingOptions::Check() const {
   joint.Check();
   solve.Check();

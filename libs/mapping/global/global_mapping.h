@@ -52,11 +52,17 @@ struct ImlsTraversalOptions {
   void Check() const;
 };
 
+// Global defaults of the joint problem and the solver (where they differ from local mapping's).
+optim::JointProblemOptions DefaultGlobalJointOptions();
+optim::SolveOptions DefaultGlobalSolveOptions();
+
+// The defaults are global_opt's (docs/global_opt.md, "Default configuration"): made for the
+// output of local mapping, whose map points are consistent with the keyframe poses.
 struct GlobalMappingOptions {
-  // alpha/beta/gamma (<= 0: ResolveWeights rule), sigmas; the visual gate and the holding of
-  // weak map points (off by default, docs/global_opt.md "Long sequences with free map points").
-  optim::JointProblemOptions joint;
-  optim::SolveOptions solve;         // LM iterations, threads.
+  // alpha/beta/gamma (<= 0: ResolveWeights rule), sigmas; the visual gate (chi2(2, 0.95)) and the
+  // holding of weak map points (docs/global_opt.md "Long sequences with free map points").
+  optim::JointProblemOptions joint = DefaultGlobalJointOptions();
+  optim::SolveOptions solve = DefaultGlobalSolveOptions();  // LM iterations, tolerance, threads.
   ImlsTraversalOptions traversal;
   bool use_directions = true;   // false: the --no-direction ablation.
   bool use_saved_imls = true;   // the set L of local mapping
@@ -88,8 +94,13 @@ struct GlobalMappingOptions {
   // > 0: the visual term uses a subset of the map points that still gives every keyframe at
   // least this many observations, or all of its own (SelectObservations): the cost of a
   // free-map-point solve grows with the observations. 0 = every point.
-  int points_per_keyframe = 0;
+  int points_per_keyframe = 200;
   void Check() const;
+
+  // Preset for inputs whose map points are not consistent with the poses (e.g. placed from the
+  // truth while the poses drift, as in the synthetic problems of the tests): every observation
+  // and every map point in the problem and free, LM to a relative cost change of 1e-6.
+  static GlobalMappingOptions EveryObservation();
 };
 
 struct GlobalMappingResult {

@@ -22,7 +22,7 @@ void BM_Global4500Frames(benchmark::State& state) {
   size_t scan_points = 0;
   for (const auto& s : syn.input.scans) scan_points += s.points.size();
   state.counters["scan_points"] = static_cast<double>(scan_points);
-  mapping::GlobalMappingOptions o;
+  auto o = mapping::GlobalMappingOptions::EveryObservation();
   o.solve.threads = static_cast<int>(state.range(0));
   for (auto _ : state) {
     const auto r = mapping::OptimizeGlobal(syn.input, o);

@@ -24,7 +24,7 @@ using testing::MakeSyntheticGlobal;
 using testing::SyntheticGlobalOptions;
 
 GlobalMappingOptions Quiet() {
-  GlobalMappingOptions o;
+  GlobalMappingOptions o = GlobalMappingOptions::EveryObservation();
   o.solve.threads = 1;
   return o;
 }
@@ -343,7 +343,7 @@ TEST(GlobalMapping, DISABLED_Sequence4500Frames) {
   const Timer build;
   const auto syn = MakeSyntheticGlobal(so);
   const double build_s = build.ElapsedSeconds();
-  GlobalMappingOptions o;
+  GlobalMappingOptions o = GlobalMappingOptions::EveryObservation();
   o.solve.threads = 2;
   const auto r = OptimizeGlobal(syn.input, o);
   size_t points = 0;
