@@ -7,6 +7,7 @@
 #include <thread>
 #include <utility>
 
+#include "app/option_group.h"
 #include "core/check.h"
 #include "io/files.h"
 #include "io/trajectory_io.h"
@@ -185,6 +186,29 @@ TEST(ToolTest, ErrorsNameFlagsInsteadOfFields) {
   EXPECT_EQ(err,
             "demo: error: --samples-per-list must be >= 1 (--imls-h 0.3, max_distance 0.5, "
             "frames 2)\n");
+}
+
+// OptionGroup: options land in their group with the default shown, and an option added with its
+// field name shows its flag in the tool's error line.
+TEST(OptionGroup, GroupsDefaultsAndFieldNames) {
+  Tool tool("demo", "d");
+  int samples = 20;
+  double h = 0.06;
+  bool deskew = true;
+  OptionGroup group(tool, "Registration");
+  CLI::Option* s = group.Add("--samples-per-list", samples, "s");
+  CLI::Option* k = group.Add("--imls-h", "kernel_h", h, "h");
+  CLI::Option* d = group.Flag("--deskew,!--no-deskew", deskew, "deskew");
+  EXPECT_EQ(s->get_group(), "Registration");
+  EXPECT_EQ(k->get_group(), "Registration");
+  EXPECT_EQ(d->get_group(), "Registration");
+  EXPECT_EQ(s->get_default_str(), "20");
+  EXPECT_EQ(k->get_default_str(), "0.06");
+  testing::internal::CaptureStderr();
+  const char* argv[] = {"demo", "--samples-per-list", "3"};
+  EXPECT_EQ(tool.Run(3, argv, [] { JVL_THROW("kernel_h must be > 0, got 0"); }), 1);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "demo: error: --imls-h must be > 0, got 0\n");
+  EXPECT_EQ(samples, 3);
 }
 
 }  // namespace

@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
       const auto& gt = *ds->ground_truth();
       double length = 0;
       for (size_t i = 1; i < gt.size(); ++i)
-        length += (gt.world_from_cam[i].translation() - gt.world_from_cam[i - 1].translation()).norm();
+        length +=
+            (gt.world_from_cam[i].translation() - gt.world_from_cam[i - 1].translation()).norm();
       std::printf("ground truth %zu poses, path length %.2f m\n", gt.size(), length);
     } else {
       std::printf("ground truth none\n");

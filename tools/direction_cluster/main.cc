@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "app/tool.h"
+#include "cli_options.h"
 #include "core/check.h"
 #include "core/strings.h"
 #include "direction/direction_cluster.h"
@@ -88,48 +89,8 @@ int main(int argc, char** argv) {
       cli.add_option("--csv", csv, "CSV of the associations: frame,cluster,u,v,dwx,dwy,dwz"));
   tool.OutputFile(
       cli.add_option("--plot", plot, "Top-view PNG of the trajectory and the clusters"));
-  cli.add_option("--v-interval", o.v_interval,
-                 "V_interval: keep associations of a cluster >= K frames apart (0 = all)")
-      ->capture_default_str();
-  cli.add_option("--up", up, "World up vector x,y,z, or auto = -y of the first prior camera")
-      ->capture_default_str();
-  cli.add_option("--th-f", o.forward_max_angle_deg,
-                 "Th_f: max angle (deg) between a VP's ground projection and the motion")
-      ->capture_default_str();
-  cli.add_option("--forward-baseline", o.forward_baseline_m,
-                 "Path length (m) over which the motion direction is measured")
-      ->capture_default_str();
-  cli.add_option("--min-ground", o.min_ground_component, "Min ground component of a VP direction")
-      ->capture_default_str();
-  cli.add_flag("--use-forward-flag", o.use_forward_flag,
-               "Also require vp_detect's is_forward flag");
-  cli.add_option("--bandwidth1", o.bandwidth1_deg, "First-level mean-shift bandwidth (deg)")
-      ->capture_default_str();
-  cli.add_option("--max-member-angle", o.max_member_angle_deg,
-                 "Max angle (deg) of a member to its first-level mode")
-      ->capture_default_str();
-  cli.add_option("--slope-subset", o.slope_subset_deg, "Slope gap (deg) that separates subsets")
-      ->capture_default_str();
-  cli.add_option("--max-sweep", o.max_sweep_deg,
-                 "A direction prior whose VP headings turn by more than this along its path (deg) "
-                 "at more than --max-turn-rate is a bend and dropped")
-      ->capture_default_str();
-  cli.add_option("--max-turn-rate", o.max_turn_rate_deg_per_100m,
-                 "Turn rate (deg/100 m) above which a turning direction prior is a bend; the "
-                 "prior's own yaw drift turns far slower")
-      ->capture_default_str();
-  cli.add_option("--th-delta", o.max_std_deg, "Th_delta: max cluster std (deg)")
-      ->capture_default_str();
-  cli.add_option("--th-n", o.min_size, "Th_n: min cluster size")->capture_default_str();
-  cli.add_option("--th-m", o.clusters_per_window, "Th_m: clusters kept per window")
-      ->capture_default_str();
-  cli.add_option("--th-l", o.window_length_m, "Th_l: window length (m of path)")
-      ->capture_default_str();
-  cli.add_option("--bandwidth2", o.bandwidth2_m, "Second-level mean-shift bandwidth (m)")
-      ->capture_default_str();
-  cli.add_option("--link-gap", o.link_gap_m,
-                 "Join second-level sub-clusters closer than this along the path (m, 0 = off)")
-      ->capture_default_str();
+  tools::AddDirectionClusterFlags(tool, &o, &up);
+
   return tool.Run(argc, argv, [&] {
     o.up = ParseUp(up);
     o.Check();

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "app/tool.h"
+#include "cli_options.h"
 #include "core/check.h"
 #include "core/memory.h"
 #include "core/timer.h"
@@ -21,7 +22,7 @@ int main(int argc, char** argv) {
                  "projection errors over all keyframes (Eq. 7), full-rate trajectory and map.");
   std::string local_path, visual_path, directions_path, prior_path, output, kitti, map_path;
   double map_voxel = 0.2;
-  bool no_direction = false, map_ascii = false, no_saved = false, no_fresh = false;
+  bool map_ascii = false;
   mapping::GlobalMappingOptions o;  // the library's defaults are the tool's
   auto& cli = tool.cli();
   tool.InputFile(cli.add_option("--local", local_path, "local artifact (local_map)")->required());
@@ -35,88 +36,20 @@ int main(int argc, char** argv) {
   tool.OutputFile(cli.add_option("-o,--output", output, "global artifact to write")->required());
   tool.OutputFile(
       cli.add_option("--kitti-poses", kitti, "Full-rate trajectory as KITTI poses text"));
-  cli.add_option("--alpha", o.joint.alpha, "Weight of the visual term")->capture_default_str();
-  cli.add_option("--beta", o.joint.beta, "Weight of e_L (<= 0: from the residual counts)")
-      ->capture_default_str();
-  cli.add_option("--gamma", o.joint.gamma, "Weight of e_D (<= 0: from the residual counts)")
-      ->capture_default_str();
-  cli.add_flag("--no-direction", no_direction, "Ablation: no direction projection residuals");
-  cli.add_flag("--no-saved-imls", no_saved, "Leave out the saved correspondence set L");
-  cli.add_flag("--no-fresh-imls", no_fresh, "Leave out the fresh IMLS traversal");
-  cli.add_option("--scan-map-size,--scan-map-frames", o.traversal.scan_map_size,
-                 "N: model scans within N frames before each keyframe (the paper's N)")
-      ->capture_default_str();
-  cli.add_option("--samples-per-list", o.traversal.association.samples_per_list,
-                 "IMLS-SLAM samples per list (9 lists) in the fresh traversal")
-      ->capture_default_str();
-  cli.add_option("--max-iterations", o.solve.max_iterations,
-                 "Levenberg-Marquardt iterations per round")
-      ->capture_default_str();
-  cli.add_option("--function-tolerance", o.solve.function_tolerance,
-                 "LM stops when an iteration lowers the cost by less than this fraction")
-      ->capture_default_str();
-  cli.add_option("--rounds", o.rounds,
-                 "Rounds of (fresh IMLS traversal at the current poses, LM solve)")
-      ->capture_default_str();
-  cli.add_option("--first-direction-round", o.first_direction_round,
-                 "Rounds before this one run without e_D (warm start; 0 = e_D in every round)")
-      ->capture_default_str();
-  std::string direction_source = mapping::ToString(o.direction_source);
-  cli.add_option("--direction-source", direction_source,
-                 "d_w of e_D: 'free' re-estimates each cluster's direction from the rotations "
-                 "after the warm-start round (robust mean, outlier VPs dropped) and optimises it "
-                 "with the poses; 'refit' keeps that re-estimate fixed; 'prior' uses "
-                 "direction_cluster's d_w as is (the paper)")
-      ->check(CLI::IsMember({"free", "refit", "prior"}))
-      ->capture_default_str();
-  cli.add_option("--refit-outlier-deg", o.refit_outlier_deg,
-                 "refit/free: smallest gate (deg) for VPs far from their cluster's direction")
-      ->capture_default_str();
-  cli.add_option("--direction-sigma", o.direction_sigma_px,
-                 "sigma of e_D in pixels (<= 0: estimated from the VP residuals when e_D enters)")
-      ->capture_default_str();
-  cli.add_option("--direction-huber", o.joint.direction_huber,
-                 "Huber threshold of e_D in sigmas (<= 0: none)")
-      ->capture_default_str();
-  cli.add_option("--visual-gate", o.joint.visual_gate_chi2,
-                 "Leave out visual observations whose squared reprojection error in sigmas "
-                 "exceeds this at the start of a round, and free map points left with < 2 "
-                 "(<= 0: keep all; with --max-point-sigma it makes free map points converge on long "
-                 "sequences, docs/global_opt.md)")
-      ->capture_default_str();
-  cli.add_option("--max-point-sigma", o.joint.max_point_sigma_ratio,
-                 "Hold free map points constant whose position sigma at the start of a round "
-                 "exceeds this fraction of their distance to the nearest observing camera "
-                 "(<= 0: all free)")
-      ->capture_default_str();
-  cli.add_flag("--drop-weak-points", o.joint.drop_weak_points,
-               "Leave the points of --max-point-sigma out (with their observations) instead of "
-               "holding them constant");
-  cli.add_option("--points-per-keyframe", o.points_per_keyframe,
-                 "Visual term on a subset of the map points (longest tracks first) that keeps at "
-                 "least this many observations per keyframe (0 = all points)")
-      ->capture_default_str();
-  cli.add_flag("!--fixed-map-points", o.joint.optimize_map_points,
-               "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only; "
-               "several times faster on long sequences, see docs/global_opt.md)");
+  tools::GlobalOptFlags flags;
+  tools::AddGlobalOptFlags(tool, &o, &flags);
   tool.OutputFile(
       cli.add_option("--map", map_path, "Accumulated map PLY (stored scans, optimised poses)"));
   cli.add_option("--map-voxel", map_voxel, "Voxel size (m) of the map")->capture_default_str();
   cli.add_flag("--map-ascii", map_ascii, "Write the PLY as ASCII instead of binary");
   return tool.Run(argc, argv, [&] {
-    o.use_directions = !no_direction;
-    using Source = mapping::GlobalMappingOptions::DirectionSource;
-    o.direction_source = direction_source == "prior"   ? Source::kPrior
-                         : direction_source == "refit" ? Source::kRefit
-                                                       : Source::kFree;
-    o.use_saved_imls = !no_saved;
-    o.fresh_traversal = !no_fresh;
+    tools::ApplyGlobalOptFlags(flags, &o);
     o.solve.threads = tool.threads();
     if (!tool.quiet()) o.solve.progress_label = "global LM";
     o.Check();
     JVL_CHECK(map_voxel == 0 || (map_voxel >= 0.01 && map_voxel <= 100),
               "--map-voxel must be 0 (every point) or in [0.01, 100] m, got " << map_voxel);
-    JVL_CHECK(no_direction || !directions_path.empty(),
+    JVL_CHECK(flags.no_direction || !directions_path.empty(),
               "--directions is required unless --no-direction is given");
     // The artifacts are released once the problem input is assembled (the largest parts are
     // moved into it), so they do not add to the peak memory of the solve.
@@ -138,7 +71,7 @@ int main(int argc, char** argv) {
       if (!directions_path.empty()) {
         directions = io::ReadDirectionsArtifact(directions_path);
         tool.AddInput(directions_path);
-        if (!no_direction && directions.associations.empty()) {
+        if (!flags.no_direction && directions.associations.empty()) {
           spdlog::warn("{}: no direction prior (no associated VP); optimising without e_D",
                        directions_path);
         }
@@ -151,7 +84,7 @@ int main(int argc, char** argv) {
       JVL_CHECK(!prior.empty(), "no prior trajectory: pass --prior");
       o.joint.octave_scale_factor = visual.scale_factor;
       input = mapping::AssembleGlobalInput(visual, std::move(local),
-                                              directions_path.empty() ? nullptr : &directions);
+                                           directions_path.empty() ? nullptr : &directions);
     }
     if (o.use_saved_imls && o.joint.SumsImlsPerPair()) {
       // The set L summed per keyframe pair once (exact, optim/imls_pair_cost.h); the
@@ -175,24 +108,25 @@ int main(int argc, char** argv) {
     if (!kitti.empty()) io::WriteTrajectoryKitti(kitti, out.trajectory);
     if (!map_path.empty()) {
       // OptimizeGlobal released its scans before the last solve; they are read again.
-      io::WritePly(map_path,
-                   mapping::AccumulateMap(result.keyframes,
-                                          mapping::ReadStoredScans(local_path), map_voxel),
-                   !map_ascii);
+      io::WritePly(
+          map_path,
+          mapping::AccumulateMap(result.keyframes, mapping::ReadStoredScans(local_path), map_voxel),
+          !map_ascii);
     }
     spdlog::debug("outputs written in {:.1f} s", writing.ElapsedSeconds());
     const auto& s = result.solve;
     spdlog::info(
-        "{} keyframes, {} frames: {} visual, {} IMLS ({} saved + {} fresh, {} keyframe-pair blocks), {} direction "
+        "{} keyframes, {} frames: {} visual, {} IMLS ({} saved + {} fresh, {} keyframe-pair "
+        "blocks), {} direction "
         "residuals ({} skipped: not keyframes, {} at infinity, {} refit outliers; sigma {:.2f} "
         "px); weights alpha {:.3g} beta {:.3g} "
         "gamma {:.3g}; cost {:.6g} -> {:.6g}; {} rounds, {} iterations ({:.2f} s IMLS "
         "traversal, {:.2f} s total)",
         result.keyframes.size(), out.trajectory.size(), s.before.visual.count, s.before.imls.count,
         result.saved_imls, result.fresh_imls, s.imls_blocks, result.directions_used,
-        result.directions_not_keyframe, result.directions_at_infinity,
-        result.directions_outliers, result.direction_sigma_px, s.weights.alpha,
-        s.weights.beta, s.weights.gamma, s.before.total, s.after.total, result.rounds,
-        result.total_iterations, result.traversal_time_s, result.total_time_s);
+        result.directions_not_keyframe, result.directions_at_infinity, result.directions_outliers,
+        result.direction_sigma_px, s.weights.alpha, s.weights.beta, s.weights.gamma, s.before.total,
+        s.after.total, result.rounds, result.total_iterations, result.traversal_time_s,
+        result.total_time_s);
   });
 }

@@ -8,21 +8,16 @@
 #include <string>
 
 #include "app/tool.h"
+#include "cli_options.h"
 #include "core/progress.h"
+#include "core/statistics.h"
 #include "core/timer.h"
 #include "io/dataset.h"
 #include "io/odometry_io.h"
 #include "io/trajectory_io.h"
 #include "lidar/odometry.h"
-#include "options.h"
 
 namespace {
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
-}
 
 void AppendFrame(const jvl::lidar::OdometryFrame& f, double stamp, jvl::io::OdometryArtifact* a) {
   const jvl::lidar::FrameDiagnostics& d = f.diagnostics;
@@ -52,14 +47,7 @@ int main(int argc, char** argv) {
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   tool.OutputFile(cli.add_option("-o,--output", output, "Odometry artifact (.h5)")->required());
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses, "Also write KITTI pose text here"));
-  jvl::lidar_odom::AddOdometryOptions(cli, options);
-  tool.FieldFlag("kernel_h", "--imls-h");
-  tool.FieldFlag("search_radius", "--imls-radius");
-  tool.FieldFlag("max_distance", "--imls-max-distance");
-  tool.FieldFlag("vertical_correction_deg", "--vertical-correction");
-  tool.FieldFlag("ground_max_angle_deg", "--ground-max-angle");
-  tool.FieldFlag("ground_max_iterations", "--ground-iterations");
-  tool.FieldFlag("ground_max_samples", "--ground-samples");
+  jvl::tools::AddLidarOdomFlags(tool, &options);
   return tool.Run(argc, argv, [&] {
     options.Check();
     const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
@@ -86,8 +74,8 @@ int main(int argc, char** argv) {
     spdlog::info(
         "{} frames; per scan {:.1f} ms median, {:.1f} ms p95, {:.1f} ms max wall, "
         "{:.1f} ms CPU mean; {} flagged; {} threads; peak memory {:.0f} MiB",
-        ids.size(), Percentile(d.time_ms, 0.5), Percentile(d.time_ms, 0.95),
-        Percentile(d.time_ms, 1.0), cpu_ms / std::max<double>(1.0, ids.size()), flagged,
+        ids.size(), jvl::Quantile(d.time_ms, 0.5), jvl::Quantile(d.time_ms, 0.95),
+        jvl::Quantile(d.time_ms, 1.0), cpu_ms / std::max<double>(1.0, ids.size()), flagged,
         tool.threads(), static_cast<double>(jvl::PeakMemoryBytes()) / (1 << 20));
     jvl::io::WriteOdometryArtifact(output, artifact, tool.MakeProvenance());
     if (!kitti_poses.empty()) jvl::io::WriteTrajectoryKitti(kitti_poses, artifact.trajectory);

@@ -42,11 +42,7 @@ int main(int argc, char** argv) {
   tool.OutputFile(cli.add_option("-o,--output", output, "Output local.h5")->required());
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses,
                                  "Also write the refined keyframes as KITTI text"));
-  tools::AddLocalMapFlags(cli, &options, &scan_options);
-  tool.FieldFlag("kernel_h", "--imls-h");
-  tool.FieldFlag("search_radius", "--imls-radius");
-  tool.FieldFlag("max_distance", "--imls-max-distance");
-  tool.FieldFlag("stored_voxel", "--scan-voxel");
+  tools::AddLocalMapFlags(tool, &options, &scan_options);
   return tool.Run(argc, argv, [&] {
     options.Check();
     scan_options.Check();
@@ -69,9 +65,9 @@ int main(int argc, char** argv) {
         input,
         [&](size_t row) {
           const PointCloud scan = dataset->LoadScan(input.frames[row]);
-          mapping::KeyframeScan prepared = mapping::PrepareKeyframeScan(
-              scan, cam0_from_velo, scan_options, options.association.samples_per_list,
-              tool.threads());
+          mapping::KeyframeScan prepared =
+              mapping::PrepareKeyframeScan(scan, cam0_from_velo, scan_options,
+                                           options.association.samples_per_list, tool.threads());
           // An empty scan is reported by the dataset; a nearly empty or degenerate one (all
           // points at the origin, a few points) leaves the keyframe's IMLS term weak or empty.
           if (!scan.empty() && prepared.sampled.size() < kFewSurfacePoints) {

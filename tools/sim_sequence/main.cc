@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "app/tool.h"
+#include "cli_options.h"
 #include "core/check.h"
 #include "core/progress.h"
 #include "core/timer.h"
@@ -29,38 +30,7 @@ int main(int argc, char** argv) {
   cli.add_option("--scenario", scenario,
                  "urban, suburban, highway or straight (highway scenery, one 1.2 km straight)")
       ->capture_default_str();
-  cli.add_option("--laps", opt.laps,
-                 "Drive the route this many times, every second lap mirrored (long sequences)")
-      ->capture_default_str();
-  cli.add_option("--seed", opt.seed, "Random seed (world layout and noise)")->capture_default_str();
-  cli.add_flag("--stop", opt.stop, "Stop for a few seconds before the second corner");
-  cli.add_option("--range-noise", opt.lidar.range_noise, "LiDAR range noise sigma (m)")
-      ->capture_default_str();
-  cli.add_option("--dropout", opt.lidar.dropout, "LiDAR random dropout probability")
-      ->capture_default_str();
-  cli.add_flag("--motion-distortion", opt.lidar.motion_distortion,
-               "Move the LiDAR during the 0.1 s sweep");
-  cli.add_option("--pixel-noise", opt.camera.pixel_noise, "Image noise sigma (grey levels)")
-      ->capture_default_str();
-  cli.add_option("--supersample", opt.camera.supersample,
-                 "Camera rays per pixel along each axis, on a rotated grid, where the pixel "
-                 "sees an edge (its area is averaged); 1: one ray per pixel centre")
-      ->check(CLI::Range(1, 8))
-      ->capture_default_str();
-  cli.add_option("--supersample-contrast", opt.camera.supersample_contrast,
-                 "A pixel is supersampled where its neighbourhood sees another surface or the "
-                 "second difference of neighbouring centre rays exceeds this many grey levels "
-                 "(negative: every pixel)")
-      ->capture_default_str();
-  cli.add_option("--exposure-variation", opt.camera.exposure_variation,
-                 "Relative frame-to-frame exposure change")
-      ->capture_default_str();
-  cli.add_option("--moving-cars", opt.scene.moving_cars, "Moving cars on the route")
-      ->capture_default_str();
-  cli.add_option("--terrain-scale", opt.scene.terrain_scale,
-                 "Scale of the rolling terrain's heights and slopes (0 = flat, 1 = slopes of a "
-                 "few percent)")
-      ->capture_default_str();
+  jvl::tools::AddSimSequenceFlags(tool, &opt);
   int64_t preview = -1;
   cli.add_option("--preview-frame", preview,
                  "Also write sim/topview_<frame>.png, a bird's-eye view of that frame's scan");

@@ -1,12 +1,11 @@
 // Command-line flags for every VisualMapOptions field (names and defaults in docs/visual_assoc.md).
 #pragma once
 
-#include <CLI/CLI.hpp>
-
+#include "app/tool.h"
 #include "mapping/visual/map_builder.h"
 
 namespace jvl::tools {
 
-void AddVisualMapFlags(CLI::App& cli, mapping::VisualMapOptions* options);
+void AddVisualMapFlags(app::Tool& tool, mapping::VisualMapOptions* options);
 
 }  // namespace jvl::tools

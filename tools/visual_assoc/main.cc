@@ -8,8 +8,8 @@
 #include "core/check.h"
 #include "core/progress.h"
 #include "io/dataset.h"
-#include "io/trajectory_io.h"
 #include "io/directions_io.h"
+#include "io/trajectory_io.h"
 #include "io/visual_io.h"
 #include "mapping/visual/map_builder.h"
 #include "mapping/visual/visual_artifact.h"
@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   tool.InputFile(cli.add_option("--directions", directions_path,
                                 "directions.h5: its frames become keyframes"));
   tool.OutputFile(cli.add_option("-o,--output", output, "Output visual.h5")->required());
-  tools::AddVisualMapFlags(cli, &options);
+  tools::AddVisualMapFlags(tool, &options);
   return tool.Run(argc, argv, [&] {
     options.Check();
     auto dataset =

@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include "app/tool.h"
+#include "cli_options.h"
 #include "core/strings.h"
 #include "io/dataset.h"
 #include "io/vps_io.h"
@@ -15,8 +16,6 @@ int main(int argc, char** argv) {
   std::string dataset_dir, format = "auto", frames = ":", output, csv;
   jvl::VpDetectRunOptions run;
   std::string detector = jvl::ToString(run.detect.segments.detector);
-  jvl::LineSegmentOptions& seg = run.detect.segments;
-  jvl::VpOptions& vp = run.detect.vp;
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
@@ -25,31 +24,10 @@ int main(int argc, char** argv) {
   tool.OutputFile(cli.add_option("-o,--output", output, "Output artifact (vps.h5)")->required());
   tool.OutputFile(cli.add_option("--csv", csv, "Also write one CSV row per VP to this file"));
   cli.add_option("--debug-dir", run.debug_dir, "Write overlay images (segments by VP) here");
-  cli.add_option("--detector", detector, "Line detector: fld or lsd")->capture_default_str();
-  cli.add_option("--line-scale", seg.scale, "Resize factor before line detection")
-      ->capture_default_str();
-  cli.add_option("--min-length", seg.min_length_px, "Min segment length (px, full res)")
-      ->capture_default_str();
-  cli.add_option("--canny-low", seg.canny_low, "FLD Canny low threshold")->capture_default_str();
-  cli.add_option("--canny-high", seg.canny_high, "FLD Canny high threshold")->capture_default_str();
-  cli.add_option("--max-vps", vp.max_vps, "Max VPs per image")->capture_default_str();
-  cli.add_option("--inlier-threshold-deg", vp.inlier_threshold_deg, "Inlier angle (deg)")
-      ->capture_default_str();
-  cli.add_option("--ransac-iterations", vp.ransac_iterations, "Segment pairs drawn per VP")
-      ->capture_default_str();
-  cli.add_option("--seed", vp.seed, "RANSAC seed")->capture_default_str();
-  cli.add_option("--min-inliers", vp.min_inliers, "Min inlier segments per VP")
-      ->capture_default_str();
-  cli.add_option("--refine-iterations", vp.refine_iterations, "Least-squares refinement rounds")
-      ->capture_default_str();
-  cli.add_option("--min-separation-deg", vp.min_separation_deg, "Min angle between VPs (deg)")
-      ->capture_default_str();
-  cli.add_option("--forward-max-angle-deg", vp.forward_max_angle_deg,
-                 "Forward VP must lie within this angle of the optical axis (deg)")
-      ->capture_default_str();
+  jvl::tools::AddVpDetectFlags(tool, &run, &detector);
 
   return tool.Run(argc, argv, [&] {
-    seg.detector = jvl::ParseLineDetector(detector);
+    run.detect.segments.detector = jvl::ParseLineDetector(detector);
     run.detect.Check();
     run.threads = tool.threads();
     run.progress = !tool.quiet();

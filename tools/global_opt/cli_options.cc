@@ -1,0 +1,71 @@
+#include "cli_options.h"
+
+#include "app/option_group.h"
+
+namespace jvl::tools {
+
+void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, GlobalOptFlags* f) {
+  f->direction_source = mapping::ToString(o->direction_source);
+  app::OptionGroup method(tool, "Method");
+  method.Add("--alpha", o->joint.alpha, "Weight of the visual term");
+  method.Add("--beta", o->joint.beta, "Weight of e_L (<= 0: from the residual counts)");
+  method.Add("--gamma", o->joint.gamma, "Weight of e_D (<= 0: from the residual counts)");
+  method.Flag("--no-direction", f->no_direction, "Ablation: no direction projection residuals");
+  method.Flag("--no-saved-imls", f->no_saved_imls, "Leave out the saved correspondence set L");
+  method.Flag("--no-fresh-imls", f->no_fresh_imls, "Leave out the fresh IMLS traversal");
+  method.Add("--scan-map-size,--scan-map-frames", o->traversal.scan_map_size,
+             "N: model scans within N frames before each keyframe (the paper's N)");
+  method.Add("--samples-per-list", o->traversal.association.samples_per_list,
+             "IMLS-SLAM samples per list (9 lists) in the fresh traversal");
+  method.Add("--max-iterations", o->solve.max_iterations,
+             "Levenberg-Marquardt iterations per round");
+  method.Add("--function-tolerance", o->solve.function_tolerance,
+             "LM stops when an iteration lowers the cost by less than this fraction");
+  method.Add("--rounds", o->rounds,
+             "Rounds of (fresh IMLS traversal at the current poses, LM solve)");
+  method.Add("--first-direction-round", o->first_direction_round,
+             "Rounds before this one run without e_D (warm start; 0 = e_D in every round)");
+  method
+      .Add("--direction-source", f->direction_source,
+           "d_w of e_D: 'free' re-estimates each cluster's direction from the rotations "
+           "after the warm-start round (robust mean, outlier VPs dropped) and optimises it "
+           "with the poses; 'refit' keeps that re-estimate fixed; 'prior' uses "
+           "direction_cluster's d_w as is (the paper)")
+      ->check(CLI::IsMember({"free", "refit", "prior"}));
+  method.Add("--refit-outlier-deg", o->refit_outlier_deg,
+             "refit/free: smallest gate (deg) for VPs far from their cluster's direction");
+  method.Add("--direction-sigma", o->direction_sigma_px,
+             "sigma of e_D in pixels (<= 0: estimated from the VP residuals when e_D enters)");
+  method.Add("--direction-huber", o->joint.direction_huber,
+             "Huber threshold of e_D in sigmas (<= 0: none)");
+  method.Add("--visual-gate", o->joint.visual_gate_chi2,
+             "Leave out visual observations whose squared reprojection error in sigmas "
+             "exceeds this at the start of a round, and free map points left with < 2 "
+             "(<= 0: keep all; with --max-point-sigma it makes free map points converge on long "
+             "sequences, docs/global_opt.md)");
+  method.Add("--max-point-sigma", o->joint.max_point_sigma_ratio,
+             "Hold free map points constant whose position sigma at the start of a round "
+             "exceeds this fraction of their distance to the nearest observing camera "
+             "(<= 0: all free)");
+  method.Flag("--drop-weak-points", o->joint.drop_weak_points,
+              "Leave the points of --max-point-sigma out (with their observations) instead of "
+              "holding them constant");
+  method.Add("--points-per-keyframe", o->points_per_keyframe,
+             "Visual term on a subset of the map points (longest tracks first) that keeps at "
+             "least this many observations per keyframe (0 = all points)");
+  method.Flag("!--fixed-map-points", o->joint.optimize_map_points,
+              "Keep the map points at their local-mapping positions (Eq. 8 optimises poses only; "
+              "several times faster on long sequences, see docs/global_opt.md)");
+}
+
+void ApplyGlobalOptFlags(const GlobalOptFlags& f, mapping::GlobalMappingOptions* o) {
+  o->use_directions = !f.no_direction;
+  using Source = mapping::GlobalMappingOptions::DirectionSource;
+  o->direction_source = f.direction_source == "prior"   ? Source::kPrior
+                        : f.direction_source == "refit" ? Source::kRefit
+                                                        : Source::kFree;
+  o->use_saved_imls = !f.no_saved_imls;
+  o->fresh_traversal = !f.no_fresh_imls;
+}
+
+}  // namespace jvl::tools

@@ -1,0 +1,39 @@
+#include "cli_options.h"
+
+#include "app/option_group.h"
+
+namespace jvl::tools {
+
+void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
+  app::OptionGroup route(tool, "Route");
+  route.Add("--laps", o->laps,
+            "Drive the route this many times, every second lap mirrored (long sequences)");
+  route.Add("--seed", o->seed, "Random seed (world layout and noise)");
+  route.Flag("--stop", o->stop, "Stop for a few seconds before the second corner");
+
+  app::OptionGroup sensors(tool, "Sensors");
+  sensors.Add("--range-noise", o->lidar.range_noise, "LiDAR range noise sigma (m)");
+  sensors.Add("--dropout", o->lidar.dropout, "LiDAR random dropout probability");
+  sensors.Flag("--motion-distortion", o->lidar.motion_distortion,
+               "Move the LiDAR during the 0.1 s sweep");
+  sensors.Add("--pixel-noise", o->camera.pixel_noise, "Image noise sigma (grey levels)");
+  sensors
+      .Add("--supersample", o->camera.supersample,
+           "Camera rays per pixel along each axis, on a rotated grid, where the pixel "
+           "sees an edge (its area is averaged); 1: one ray per pixel centre")
+      ->check(CLI::Range(1, 8));
+  sensors.Add("--supersample-contrast", o->camera.supersample_contrast,
+              "A pixel is supersampled where its neighbourhood sees another surface or the "
+              "second difference of neighbouring centre rays exceeds this many grey levels "
+              "(negative: every pixel)");
+  sensors.Add("--exposure-variation", o->camera.exposure_variation,
+              "Relative frame-to-frame exposure change");
+
+  app::OptionGroup world(tool, "World");
+  world.Add("--moving-cars", o->scene.moving_cars, "Moving cars on the route");
+  world.Add("--terrain-scale", o->scene.terrain_scale,
+            "Scale of the rolling terrain's heights and slopes (0 = flat, 1 = slopes of a "
+            "few percent)");
+}
+
+}  // namespace jvl::tools
