@@ -19,7 +19,7 @@ std::string ToString(AssociationMode mode) {
 }
 
 void AssociationOptions::Check() const {
-  JVL_CHECK(std::isfinite(max_dt) && max_dt >= 0, "--max-dt must be >= 0 (got " << max_dt << ")");
+  JVL_CHECK(std::isfinite(max_dt) && max_dt >= 0, "max_dt must be >= 0 (got " << max_dt << ")");
 }
 
 namespace {

@@ -137,9 +137,9 @@ RpeUnit ParseRpeUnit(const std::string& name) {
 std::string ToString(RpeUnit unit) { return unit == RpeUnit::kFrames ? "frames" : "m"; }
 
 void RpeOptions::Check() const {
-  JVL_CHECK(std::isfinite(delta) && delta > 0, "--rpe-delta must be > 0 (got " << delta << ")");
+  JVL_CHECK(std::isfinite(delta) && delta > 0, "delta must be > 0 (got " << delta << ")");
   JVL_CHECK(unit != RpeUnit::kFrames || delta == std::floor(delta),
-            "--rpe-delta must be a whole number of frames (got " << delta << ")");
+            "delta must be a whole number of frames (got " << delta << ")");
 }
 
 RpeResult ComputeRpe(const PairedPoses& paired, const std::vector<double>& gt_distances,

@@ -12,14 +12,14 @@ namespace jvl::sim {
 constexpr double kPi = 3.14159265358979323846;
 
 void LidarOptions::Check() const {
-  JVL_CHECK(beams >= 2 && beams <= 256, "LiDAR beams must be in [2, 256], got " << beams);
-  JVL_CHECK(elevation_max_deg > elevation_min_deg, "LiDAR elevation max must exceed min");
-  JVL_CHECK(azimuth_steps >= 16, "LiDAR azimuth steps must be >= 16");
-  JVL_CHECK(max_range > min_range && min_range >= 0, "LiDAR range limits are inconsistent");
-  JVL_CHECK(range_noise >= 0, "LiDAR range noise must be >= 0");
-  JVL_CHECK(dropout >= 0 && dropout < 1, "LiDAR dropout must be in [0, 1)");
-  JVL_CHECK(glass_dropout >= 0 && glass_dropout <= 1, "glass dropout must be in [0, 1]");
-  JVL_CHECK(sweep_period > 0, "sweep period must be positive");
+  JVL_CHECK(beams >= 2 && beams <= 256, "beams must be in [2, 256], got " << beams);
+  JVL_CHECK(elevation_max_deg > elevation_min_deg, "elevation_max_deg must exceed elevation_min_deg");
+  JVL_CHECK(azimuth_steps >= 16, "azimuth_steps must be >= 16, got " << azimuth_steps);
+  JVL_CHECK(max_range > min_range && min_range >= 0, "min_range must be >= 0 and below max_range, got " << min_range << " and " << max_range);
+  JVL_CHECK(range_noise >= 0, "range_noise must be >= 0, got " << range_noise);
+  JVL_CHECK(dropout >= 0 && dropout < 1, "dropout must be in [0, 1), got " << dropout);
+  JVL_CHECK(glass_dropout >= 0 && glass_dropout <= 1, "glass_dropout must be in [0, 1], got " << glass_dropout);
+  JVL_CHECK(sweep_period > 0, "sweep_period must be > 0, got " << sweep_period);
 }
 
 std::vector<double> LidarOptions::ElevationsRad() const {

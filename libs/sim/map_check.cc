@@ -60,11 +60,11 @@ nlohmann::json StatsJson(const SurfaceDistanceStats& s) {
 }  // namespace
 
 void SurfaceCheckOptions::Check() const {
-  JVL_CHECK(max_depth > 0, "--max-depth must be > 0, got " << max_depth);
-  JVL_CHECK(threshold > 0, "--threshold must be > 0, got " << threshold);
-  JVL_CHECK(depth_bins.size() >= 2, "depth bins need at least two edges");
+  JVL_CHECK(max_depth > 0, "max_depth must be > 0, got " << max_depth);
+  JVL_CHECK(threshold > 0, "threshold must be > 0, got " << threshold);
+  JVL_CHECK(depth_bins.size() >= 2, "depth_bins need at least two edges");
   for (size_t i = 1; i < depth_bins.size(); ++i) {
-    JVL_CHECK(depth_bins[i] > depth_bins[i - 1], "depth bin edges must increase");
+    JVL_CHECK(depth_bins[i] > depth_bins[i - 1], "depth_bins edges must increase");
   }
 }
 

@@ -15,7 +15,7 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 void PriorOptions::Check() const {
   for (double v : {yaw_bias_walk, yaw_noise_deg, pitch_roll_walk, pitch_roll_noise_deg, scale_walk,
                    jitter_translation_m, jitter_rotation_deg}) {
-    JVL_CHECK(v >= 0 && std::isfinite(v), "prior noise levels must be finite and >= 0");
+    JVL_CHECK(v >= 0 && std::isfinite(v), "the noise levels (yaw_bias_walk, yaw_noise_deg, pitch_roll_walk, pitch_roll_noise_deg, scale_walk, jitter_translation_m, jitter_rotation_deg) must be finite and >= 0");
   }
   JVL_CHECK(std::abs(scale_bias) < 0.5,
             "scale bias (--scale-bias) must be in (-0.5, 0.5), got " << scale_bias);

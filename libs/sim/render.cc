@@ -11,12 +11,12 @@
 namespace jvl::sim {
 
 void CameraOptions::Check() const {
-  JVL_CHECK(pixel_noise >= 0, "pixel noise must be >= 0");
+  JVL_CHECK(pixel_noise >= 0, "pixel_noise must be >= 0, got " << pixel_noise);
   JVL_CHECK(exposure_variation >= 0 && exposure_variation < 0.5,
-            "exposure variation must be in [0, 0.5)");
-  JVL_CHECK(blur_sigma >= 0 && blur_sigma < 5, "blur sigma must be in [0, 5)");
-  JVL_CHECK(max_range > 1, "camera max range must exceed 1 m");
-  JVL_CHECK(sun_direction.norm() > 0, "sun direction must be non-zero");
+            "exposure_variation must be in [0, 0.5), got " << exposure_variation);
+  JVL_CHECK(blur_sigma >= 0 && blur_sigma < 5, "blur_sigma must be in [0, 5), got " << blur_sigma);
+  JVL_CHECK(max_range > 1, "max_range must exceed 1 m, got " << max_range);
+  JVL_CHECK(sun_direction.norm() > 0, "sun_direction must be non-zero");
 }
 
 double ExposureGain(int64_t frame, double variation, uint64_t seed) {

@@ -205,7 +205,7 @@ std::vector<RoadPiece> ScenarioLap(Scenario scenario) {
 }  // namespace
 
 std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps) {
-  JVL_CHECK(laps >= 1 && laps <= 100, "--laps must be in [1, 100], got " << laps);
+  JVL_CHECK(laps >= 1 && laps <= 100, "laps must be in [1, 100], got " << laps);
   std::vector<RoadPiece> pieces;
   for (int lap = 0; lap < laps; ++lap) {
     for (RoadPiece p : ScenarioLap(scenario)) {
@@ -217,9 +217,9 @@ std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps) {
 }
 
 void DriveOptions::Check() const {
-  JVL_CHECK(frame_rate_hz > 0, "frame rate must be positive, got " << frame_rate_hz);
-  JVL_CHECK(max_accel > 0 && max_decel > 0, "acceleration limits must be positive");
-  JVL_CHECK(stop_duration >= 0, "stop duration must be >= 0");
+  JVL_CHECK(frame_rate_hz > 0, "frame_rate_hz must be > 0, got " << frame_rate_hz);
+  JVL_CHECK(max_accel > 0 && max_decel > 0, "max_accel and max_decel must be > 0, got " << max_accel << " and " << max_decel);
+  JVL_CHECK(stop_duration >= 0, "stop_duration must be >= 0, got " << stop_duration);
 }
 
 Drive PlanDrive(const Route& route, const DriveOptions& options) {

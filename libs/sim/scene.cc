@@ -235,12 +235,12 @@ std::array<Eigen::Vector2d, 4> Building::Corners() const {
 }
 
 void SceneOptions::Check() const {
-  JVL_CHECK(road_half_width > 3.5, "road half width must exceed one lane (3.5 m)");
-  JVL_CHECK(sidewalk_width >= 0, "sidewalk width must be >= 0");
-  JVL_CHECK(ground_cell > 0.2 && ground_cell <= 10, "ground cell must be in (0.2, 10] m");
-  JVL_CHECK(moving_cars >= 0, "moving car count must be >= 0");
+  JVL_CHECK(road_half_width > 3.5, "road_half_width must exceed one lane (3.5 m), got " << road_half_width);
+  JVL_CHECK(sidewalk_width >= 0, "sidewalk_width must be >= 0, got " << sidewalk_width);
+  JVL_CHECK(ground_cell > 0.2 && ground_cell <= 10, "ground_cell must be in (0.2, 10] m, got " << ground_cell);
+  JVL_CHECK(moving_cars >= 0, "moving_cars must be >= 0, got " << moving_cars);
   JVL_CHECK(std::isfinite(terrain_scale) && terrain_scale >= 0 && terrain_scale <= 5,
-            "terrain scale must be in [0, 5], got " << terrain_scale);
+            "terrain_scale must be in [0, 5], got " << terrain_scale);
 }
 
 Box Scene::MovingCarBox(size_t i, double t) const {

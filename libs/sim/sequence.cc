@@ -36,8 +36,8 @@ Calibration KittiCalibration() {
 }
 
 void SequenceOptions::Check() const {
-  JVL_CHECK(frames >= 0, "--frames must be >= 0 (0 = whole route), got " << frames);
-  JVL_CHECK(lidar_height > 0.5 && lidar_height < 5, "LiDAR height must be in (0.5, 5) m");
+  JVL_CHECK(frames >= 0, "frames must be >= 0 (0 = whole route), got " << frames);
+  JVL_CHECK(lidar_height > 0.5 && lidar_height < 5, "lidar_height must be in (0.5, 5) m, got " << lidar_height);
   JVL_CHECK(calibration.image_width > 0 && calibration.image_height > 0,
             "calibration has no image size");
   drive.Check();

@@ -31,8 +31,8 @@ bool FastLineDetectorAvailable() {
 }
 
 void LineSegmentOptions::Check() const {
-  JVL_CHECK(scale > 0.05 && scale <= 1.0, "line scale must be in (0.05, 1], got " << scale);
-  JVL_CHECK(min_length_px >= 0, "min segment length must be >= 0, got " << min_length_px);
+  JVL_CHECK(scale > 0.05 && scale <= 1.0, "scale must be in (0.05, 1], got " << scale);
+  JVL_CHECK(min_length_px >= 0, "min_length_px must be >= 0, got " << min_length_px);
   // The fast line detector asserts on zero thresholds, so they must be strictly positive.
   JVL_CHECK(canny_low > 0 && canny_high >= canny_low && std::isfinite(canny_high),
             "Canny thresholds (--canny-low, --canny-high) must satisfy 0 < low <= high, got "

@@ -559,7 +559,7 @@ TEST_F(BadInputTest, InvalidOptions) {
   ExpectError("lidar_odom", seq + " --log-level loud", "--log-level: unknown level 'loud'");
   ExpectError("vp_detect", seq + " --canny-low 0", "--canny-low");
   ExpectError("vp_detect", seq + " --detector hough", "hough");
-  ExpectError("vp_detect", seq + " --line-scale 0", "line scale");
+  ExpectError("vp_detect", seq + " --line-scale 0", "--line-scale must be in (0.05, 1]");
   ExpectError(
       "direction_cluster",
       "--vps " + In("vps.h5") + " --prior " + In("prior.h5") + " -o " + Bad("x.h5") + " --up 0,0,0",

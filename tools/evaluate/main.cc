@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   cli.add_option("--assoc", assoc, "Association: frame (index) | timestamp")->capture_default_str();
   cli.add_option("--max-dt", c.options.association.max_dt, "Timestamp association tolerance (s)")
       ->capture_default_str();
+  tool.FieldFlag("delta", "--rpe-delta");
   cli.add_option("--rpe-delta", c.options.rpe.delta, "RPE step (frames or metres)")
       ->capture_default_str();
   cli.add_option("--rpe-unit", rpe_unit, "RPE step unit: frames | m")->capture_default_str();

@@ -21,7 +21,7 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
              "Levenberg-Marquardt iterations per round");
   method.Add("--function-tolerance", o->solve.function_tolerance,
              "LM stops when an iteration lowers the cost by less than this fraction");
-  method.Add("--rounds", o->rounds,
+  method.Add("--rounds", "rounds", o->rounds,
              "Rounds of (fresh IMLS traversal at the current poses, LM solve)");
   method.Add("--first-direction-round", o->first_direction_round,
              "Rounds before this one run without e_D (warm start; 0 = e_D in every round)");
@@ -34,7 +34,7 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
       ->check(CLI::IsMember({"free", "refit", "prior"}));
   method.Add("--refit-outlier-deg", o->refit_outlier_deg,
              "refit/free: smallest gate (deg) for VPs far from their cluster's direction");
-  method.Add("--direction-sigma", o->direction_sigma_px,
+  method.Add("--direction-sigma", "direction_sigma_px", o->direction_sigma_px,
              "sigma of e_D in pixels (<= 0: estimated from the VP residuals when e_D enters)");
   method.Add("--direction-huber", o->joint.direction_huber,
              "Huber threshold of e_D in sigmas (<= 0: none)");

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   cli.add_option("--max-depth", options.max_depth,
                  "Points deeper in their nearest view are skipped (m)")
       ->capture_default_str();
+  tool.FieldFlag("threshold", "--threshold");
   cli.add_option("--threshold", options.threshold, "On the surface: perpendicular distance (m)")
       ->capture_default_str();
   tool.OutputFile(

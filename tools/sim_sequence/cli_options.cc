@@ -6,14 +6,14 @@ namespace jvl::tools {
 
 void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
   app::OptionGroup route(tool, "Route");
-  route.Add("--laps", o->laps,
+  route.Add("--laps", "laps", o->laps,
             "Drive the route this many times, every second lap mirrored (long sequences)");
   route.Add("--seed", o->seed, "Random seed (world layout and noise)");
   route.Flag("--stop", o->stop, "Stop for a few seconds before the second corner");
 
   app::OptionGroup sensors(tool, "Sensors");
   sensors.Add("--range-noise", o->lidar.range_noise, "LiDAR range noise sigma (m)");
-  sensors.Add("--dropout", o->lidar.dropout, "LiDAR random dropout probability");
+  sensors.Add("--dropout", "dropout", o->lidar.dropout, "LiDAR random dropout probability");
   sensors.Flag("--motion-distortion", o->lidar.motion_distortion,
                "Move the LiDAR during the 0.1 s sweep");
   sensors.Add("--pixel-noise", o->camera.pixel_noise, "Image noise sigma (grey levels)");

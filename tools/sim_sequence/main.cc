@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
                  "urban, suburban, highway or straight (highway scenery, one 1.2 km straight)")
       ->capture_default_str();
   jvl::tools::AddSimSequenceFlags(tool, &opt);
+  tool.FieldFlag("frames", "--frames");
   int64_t preview = -1;
   cli.add_option("--preview-frame", preview,
                  "Also write sim/topview_<frame>.png, a bird's-eye view of that frame's scan");

@@ -9,8 +9,9 @@ void AddVpDetectFlags(app::Tool& tool, VpDetectRunOptions* run, std::string* det
   VpOptions& vp = run->detect.vp;
   app::OptionGroup method(tool, "Method");
   method.Add("--detector", *detector, "Line detector: fld or lsd");
-  method.Add("--line-scale", seg.scale, "Resize factor before line detection");
-  method.Add("--min-length", seg.min_length_px, "Min segment length (px, full res)");
+  method.Add("--line-scale", "scale", seg.scale, "Resize factor before line detection");
+  method.Add("--min-length", "min_length_px", seg.min_length_px,
+             "Min segment length (px, full res)");
   method.Add("--canny-low", seg.canny_low, "FLD Canny low threshold");
   method.Add("--canny-high", seg.canny_high, "FLD Canny high threshold");
   method.Add("--max-vps", vp.max_vps, "Max VPs per image");

@@ -76,15 +76,15 @@ void GlobalMappingOptions::Check() const {
   solve.Check();
   traversal.Check();
   JVL_CHECK(rounds >= 1, "rounds must be >= 1, got " << rounds);
-  JVL_CHECK(first_direction_round >= 0, "first_direction_round must be >= 0");
+  JVL_CHECK(first_direction_round >= 0, "first_direction_round must be >= 0, got " << first_direction_round);
   JVL_CHECK(std::isfinite(refit_outlier_deg) && refit_outlier_deg > 0 && refit_outlier_deg < 90,
-            "refit outlier threshold must be in (0, 90) degrees, got " << refit_outlier_deg);
-  JVL_CHECK(refit_min_support >= 1, "refit minimum support must be >= 1");
+            "refit_outlier_deg must be in (0, 90) degrees, got " << refit_outlier_deg);
+  JVL_CHECK(refit_min_support >= 1, "refit_min_support must be >= 1, got " << refit_min_support);
   JVL_CHECK(points_per_keyframe >= 0,
-            "points per keyframe must be >= 0 (0 = all), got " << points_per_keyframe);
+            "points_per_keyframe must be >= 0 (0 = all), got " << points_per_keyframe);
   JVL_CHECK(std::isfinite(direction_sigma_px) && std::isfinite(min_direction_sigma_px) &&
                 min_direction_sigma_px > 0,
-            "direction sigma must be finite and its minimum positive");
+            "direction_sigma_px must be finite and min_direction_sigma_px > 0");
 }
 
 int64_t SelectObservations(std::vector<optim::VisualObservation>* observations, size_t num_points,
