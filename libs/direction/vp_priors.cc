@@ -11,7 +11,7 @@
 namespace jvl::direction {
 
 DirectionSelection SelectDirections(const Trajectory& keyframes,
-                                    const std::vector<DirectionAssociation>& associations) {
+                                    const std::vector<VpAssociation>& associations) {
   DirectionSelection out;
   for (const auto& a : associations) {
     const auto row = keyframes.IndexOf(a.frame);

@@ -15,7 +15,7 @@
 namespace jvl::direction {
 
 // A VP of a frame associated with a direction prior d_w (a row of the directions artifact).
-struct DirectionAssociation {
+struct VpAssociation {
   int64_t frame = 0;
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // Pixels; NaN if the VP is at infinity.
   Eigen::Vector3d direction_world = Eigen::Vector3d::UnitZ();
@@ -48,7 +48,7 @@ struct DirectionRefit {
 // One prior per association of a keyframe with a finite VP (a VP at infinity has no pixel v
 // for Eq. 6). Throws if a used d_w is not a unit vector.
 DirectionSelection SelectDirections(const Trajectory& keyframes,
-                                    const std::vector<DirectionAssociation>& associations);
+                                    const std::vector<VpAssociation>& associations);
 
 // Re-estimates d_w of every cluster from the rotations of `keyframes` (rows as in `selection`):
 // each VP v of keyframe n gives the world direction R_wn K^-1 v (sign of the old d_w); d_w is

@@ -39,7 +39,7 @@ struct GlobalMapInput {
   // e_L form (JointProblemOptions::compress_imls, no Huber kernel on e_L).
   std::vector<optim::ImlsPair> saved_imls_pairs;
   std::vector<lidar::StoredScan> scans;                     // One per keyframe row (may be empty).
-  std::vector<direction::DirectionAssociation> directions;  // Any frames; non-keyframes skipped.
+  std::vector<direction::VpAssociation> directions;  // Any frames; non-keyframes skipped.
   void Check() const;
 };
 
