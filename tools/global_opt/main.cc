@@ -86,12 +86,6 @@ int main(int argc, char** argv) {
       input = mapping::AssembleGlobalInput(visual, std::move(local),
                                            directions_path.empty() ? nullptr : &directions);
     }
-    if (o.use_saved_imls && o.joint.SumsImlsPerPair()) {
-      // The set L summed per keyframe pair once (exact, optim/imls_pair_cost.h); the
-      // correspondences themselves are not kept.
-      input.saved_imls_pairs = optim::AggregateImls(input.saved_imls);
-      std::vector<optim::ImlsCorrespondence>().swap(input.saved_imls);
-    }
     ReleaseFreeHeapMemory();  // what reading the artifacts allocated and freed (core/memory.h)
     spdlog::debug("artifacts read and assembled in {:.1f} s", reading.ElapsedSeconds());
     const auto result = mapping::OptimizeGlobal(std::move(input), o);

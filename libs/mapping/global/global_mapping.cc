@@ -283,8 +283,11 @@ void SelectVisualTerm(const GlobalMappingOptions& options, GlobalMapInput* input
   }
 }
 
-FixedTerms PrepareFixedTerms(const GlobalMapInput& input, const GlobalMappingOptions& options,
+// Also releases the saved correspondences once they are summed per pair (they are a large part
+// of the memory on a long sequence).
+FixedTerms PrepareFixedTerms(GlobalMapInput* in, const GlobalMappingOptions& options,
                              GlobalMappingResult* result) {
+  const GlobalMapInput& input = *in;
   FixedTerms t;
   t.directions = direction::SelectDirections(input.keyframes, input.directions);
   result->directions_not_keyframe = t.directions.not_keyframe;
@@ -307,6 +310,10 @@ FixedTerms PrepareFixedTerms(const GlobalMapInput& input, const GlobalMappingOpt
   }
   t.saved_count = static_cast<int64_t>(input.saved_imls.size());
   for (const auto& p : input.saved_imls_pairs) t.saved_count += p.sum.count();
+  if (t.summed_saved) {
+    std::vector<optim::ImlsCorrespondence>().swap(in->saved_imls);
+    ReleaseFreeHeapMemory();
+  }
   return t;
 }
 
@@ -474,7 +481,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   GlobalMappingResult result;
   result.keyframes = input.keyframes;
   SelectVisualTerm(options, &input, &result);
-  const FixedTerms terms = PrepareFixedTerms(input, options, &result);
+  const FixedTerms terms = PrepareFixedTerms(&input, options, &result);
   optim::JointProblemInput problem;
   problem.camera = input.camera;
   problem.fixed = {0};  // gauge: the first keyframe
