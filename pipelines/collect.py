@@ -98,7 +98,7 @@ def read_ape_frames(path):
 
 def value_text(var, value):
     if value == "":
-        return "rule" if var in ("BETA", "GAMMA") else "default"
+        return "rule" if var == "BETA" else "default"
     return value
 
 

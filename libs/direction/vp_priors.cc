@@ -100,9 +100,13 @@ DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera&
   return out;
 }
 
-double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
-                            const std::vector<VpPrior>& priors) {
-  std::vector<double> e;
+namespace {
+
+// v - pi(R_nw d_w) of every prior whose direction is not parallel to the image plane.
+std::vector<Eigen::Vector2d> DirectionErrors(const Trajectory& keyframes,
+                                             const PinholeCamera& camera,
+                                             const std::vector<VpPrior>& priors) {
+  std::vector<Eigen::Vector2d> e;
   e.reserve(priors.size());
   for (const VpPrior& p : priors) {
     Eigen::Vector3d d =
@@ -110,9 +114,115 @@ double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& ca
         p.direction_world;
     if (d.z() < 0) d = -d;  // unoriented, as in the cost
     if (d.z() < 1e-6) continue;
-    e.push_back((camera.Project(d) - p.vp).norm());
+    e.push_back(p.vp - camera.Project(d));
   }
-  return UpperMedian(std::move(e));
+  return e;
+}
+
+}  // namespace
+
+double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
+                            const std::vector<VpPrior>& priors) {
+  std::vector<double> norms;
+  for (const Eigen::Vector2d& e : DirectionErrors(keyframes, camera, priors))
+    norms.push_back(e.norm());
+  return UpperMedian(std::move(norms));
+}
+
+Eigen::Vector2d MedianAbsDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
+                                        const std::vector<VpPrior>& priors) {
+  std::vector<double> u, v;
+  for (const Eigen::Vector2d& e : DirectionErrors(keyframes, camera, priors)) {
+    u.push_back(std::abs(e.x()));
+    v.push_back(std::abs(e.y()));
+  }
+  return {UpperMedian(std::move(u)), UpperMedian(std::move(v))};
+}
+
+VerticalSelection SelectVertical(const Trajectory& keyframes, const std::vector<VpRay>& rays,
+                                 const Eigen::Vector3d& up_world, double max_angle_deg,
+                                 double outlier_deg, double min_sigma_deg) {
+  JVL_CHECK(up_world.norm() > 0.5, "SelectVertical: up direction must be a unit vector");
+  const Eigen::Vector3d up = up_world.normalized();
+  std::map<int64_t, size_t> row_of;
+  for (size_t r = 0; r < keyframes.size(); ++r) row_of[keyframes.frames[r]] = r;
+  // Per keyframe row: the candidate ray and its world direction (oriented like up).
+  std::map<size_t, std::pair<Eigen::Vector3d, Eigen::Vector3d>> best;
+  for (const VpRay& v : rays) {
+    const auto it = row_of.find(v.frame);
+    if (it == row_of.end() || !v.ray.allFinite() || v.ray.norm() < 0.5) continue;
+    const Eigen::Vector3d ray = v.ray.normalized();
+    Eigen::Vector3d w = keyframes.world_from_cam[it->second].rotation() * ray;
+    if (w.dot(up) < 0) w = -w;
+    if (AngleDeg(w, up) > max_angle_deg) continue;
+    const auto b = best.find(it->second);
+    if (b == best.end() || w.dot(up) > b->second.second.dot(up)) best[it->second] = {ray, w};
+  }
+  VerticalSelection out;
+  out.candidates = static_cast<int64_t>(best.size());
+  if (best.empty()) return out;
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  for (const auto& [row, rw] : best) d += rw.second;
+  d.normalize();
+  std::vector<size_t> kept;
+  double median_deg = 0;
+  for (int it = 0; it < 20; ++it) {
+    std::vector<double> angles;
+    for (const auto& [row, rw] : best)
+      if (kept.empty() || std::find(kept.begin(), kept.end(), row) != kept.end())
+        angles.push_back(AngleDeg(rw.second, d));
+    median_deg = UpperMedian(std::move(angles));
+    const double gate = std::max(outlier_deg, 3.0 * median_deg / 1.1774);
+    std::vector<size_t> next;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& [row, rw] : best)
+      if (AngleDeg(rw.second, d) <= gate) {
+        next.push_back(row);
+        sum += rw.second;
+      }
+    if (next.empty()) {
+      kept.clear();
+      break;
+    }
+    const bool stable = next == kept;
+    kept = std::move(next);
+    d = sum.normalized();
+    if (stable) break;
+  }
+  out.outliers = out.candidates - static_cast<int64_t>(kept.size());
+  if (kept.empty()) return out;
+  std::vector<double> angles;
+  for (const size_t row : kept) {
+    out.rows.push_back(static_cast<int64_t>(row));
+    out.rays.push_back(best.at(row).first);
+    angles.push_back(AngleDeg(best.at(row).second, d));
+  }
+  out.direction = d;
+  // Errors in the tangent plane of d, in keyframe order (kept is sorted by row).
+  const Eigen::Vector3d helper =
+      std::abs(d.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d b1 = d.cross(helper).normalized(), b2 = d.cross(b1);
+  std::vector<Eigen::Vector2d> e;
+  for (const size_t row : kept) {
+    const Eigen::Vector3d& w = best.at(row).second;
+    e.emplace_back(w.dot(b1), w.dot(b2));
+  }
+  if (e.size() >= 3) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero(), var = Eigen::Vector2d::Zero(),
+                    diff = Eigen::Vector2d::Zero();
+    for (const auto& x : e) mean += x;
+    mean /= static_cast<double>(e.size());
+    for (const auto& x : e) var += (x - mean).cwiseAbs2();
+    var /= static_cast<double>(e.size());
+    for (size_t i = 1; i < e.size(); ++i) diff += (e[i] - e[i - 1]).cwiseAbs2();
+    diff /= static_cast<double>(e.size() - 1);
+    double rho = 0;
+    for (int k = 0; k < 2; ++k) rho += var[k] > 0 ? 0.5 * (1.0 - diff[k] / (2.0 * var[k])) : 0.0;
+    out.rho = std::clamp(rho, 0.0, 0.9);
+    out.inflation = std::sqrt((1.0 + out.rho) / (1.0 - out.rho));
+  }
+  out.sigma_deg = std::max(min_sigma_deg, UpperMedian(std::move(angles)) / 1.1774) * out.inflation;
+  return out;
 }
 
 }  // namespace jvl::direction

@@ -24,8 +24,8 @@ struct VpAssociation {
 
 // One e_D residual's data: the VP v of keyframe row `keyframe` and the world direction d_w.
 struct VpPrior {
-  int64_t keyframe = 0;  // Row of the keyframe trajectory.
-  Eigen::Vector2d vp = Eigen::Vector2d::Zero();  // Pixels, finite.
+  int64_t keyframe = 0;                                        // Row of the keyframe trajectory.
+  Eigen::Vector2d vp = Eigen::Vector2d::Zero();                // Pixels, finite.
   Eigen::Vector3d direction_world = Eigen::Vector3d::UnitZ();  // Unit.
 };
 
@@ -64,5 +64,43 @@ DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera&
 // skipped.
 double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
                             const std::vector<VpPrior>& priors);
+
+// The same per image axis: (median |u error|, median |v error|), NaN if empty.
+Eigen::Vector2d MedianAbsDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
+                                        const std::vector<VpPrior>& priors);
+
+// A vanishing direction of a frame as a unit ray in its camera (vps artifact; any VP, possibly
+// at infinity in the image).
+struct VpRay {
+  int64_t frame = 0;
+  Eigen::Vector3d ray = Eigen::Vector3d::UnitZ();
+};
+
+// The vertical direction prior (beyond the paper): per keyframe the VP closest to the world's
+// up direction, which every keyframe of the drive shares (vertical edges of buildings, poles,
+// signs), so that it ties roll and pitch along the whole drive, across turns.
+struct VerticalSelection {
+  std::vector<int64_t> rows;          // Keyframe rows with an inlier vertical VP.
+  std::vector<Eigen::Vector3d> rays;  // Their rays (camera frame, unit).
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitY();  // Robust mean in the world (up).
+  // From the median angle of the inliers to it (2D Gaussian), times `inflation`.
+  double sigma_deg = 0;
+  // Lag-1 correlation of consecutive inliers' errors (mean over the two tangent axes, in
+  // [0, 0.9]) and the AR(1) effective-sample-size inflation of sigma, sqrt((1 + rho) / (1 - rho)):
+  // the errors of neighbouring keyframes come from the same edges and are not independent.
+  double rho = 0;
+  double inflation = 1;
+  int64_t candidates = 0;  // Keyframes with a VP within max_angle_deg of up.
+  int64_t outliers = 0;    // Candidates outside the gate.
+};
+
+// `up_world` is the world's up direction as the keyframes see it (e.g. minus the y axis of the
+// first camera, as direction_cluster takes it). Candidates: per keyframe the ray with the
+// smallest angle to R_nw up, if below max_angle_deg; then the robust mean of R_wn ray with the
+// gate max(outlier_deg, 3 sigma) of RefitDirections. sigma_deg is at least min_sigma_deg before
+// the inflation for correlated errors.
+VerticalSelection SelectVertical(const Trajectory& keyframes, const std::vector<VpRay>& rays,
+                                 const Eigen::Vector3d& up_world, double max_angle_deg,
+                                 double outlier_deg, double min_sigma_deg);
 
 }  // namespace jvl::direction

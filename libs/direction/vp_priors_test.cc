@@ -2,11 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 
 #include "direction/synthetic_vps.h"
+#include "geometry/angles.h"
 #include "geometry/rigid3.h"
 
 namespace jvl::direction {
@@ -47,8 +49,8 @@ RefitCase MakeRefitCase(int n, double noise_px, double old_error_deg, uint32_t s
     const Rigid3d pose(ExpSO3(Eigen::Vector3d(0.001 * i, 0.004 * i, 0)),
                        Eigen::Vector3d(0, 0, 2.0 * i));
     rc.keyframes.Append(i, pose);
-    const Eigen::Vector2d v = camera.Project(pose.rotation().conjugate() * rc.truth) +
-                              Eigen::Vector2d(g(rng), g(rng));
+    const Eigen::Vector2d v =
+        camera.Project(pose.rotation().conjugate() * rc.truth) + Eigen::Vector2d(g(rng), g(rng));
     rc.selection.priors.push_back({i, v, old});
     rc.selection.clusters.push_back(4);
   }
@@ -90,6 +92,66 @@ TEST(VpPriors, MedianDirectionErrorMeasuresTheProjectionOfDw) {
   EXPECT_NEAR(MedianDirectionError(rc.keyframes, camera, rc.selection.priors),
               camera.fx * std::tan(0.5 * M_PI / 180.0), 0.3);
   EXPECT_TRUE(std::isnan(MedianDirectionError(rc.keyframes, camera, {})));
+}
+
+// Keyframes along a road with roll and pitch wobble; each sees the world's up (plus noise) and a
+// forward VP; one keyframe's vertical candidate is 5 deg off (a leaning edge).
+TEST(VpPriors, SelectVerticalTakesTheVpNearestUpAndGatesOutliers) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.1 * M_PI / 180.0);
+  const Eigen::Vector3d up(0, -1, 0);  // KITTI camera world: y down
+  Trajectory kf;
+  std::vector<VpRay> rays;
+  for (int i = 0; i < 40; ++i) {
+    const Eigen::Matrix3d r =
+        (Eigen::AngleAxisd(0.02 * std::sin(0.3 * i), Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(0.01 * std::cos(0.2 * i), Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+    kf.Append(2 * i, Rigid3d(Eigen::Quaterniond(r), Eigen::Vector3d(0, 0, i)));
+    Eigen::Vector3d ray = r.transpose() * up;  // up in the camera
+    ray = (ray + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))).normalized();
+    if (i == 17) ray = Eigen::AngleAxisd(5.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * ray;
+    rays.push_back({2 * i, (i % 2 ? -1.0 : 1.0) * ray});                    // unoriented
+    rays.push_back({2 * i, Eigen::Vector3d(0.01, 0.0, 1.0).normalized()});  // forward VP
+  }
+  rays.push_back({1, Eigen::Vector3d(0, 1, 0)});  // not a keyframe
+  const VerticalSelection v = SelectVertical(kf, rays, up, 10.0, 1.0, 0.05);
+  EXPECT_EQ(v.candidates, 40);
+  EXPECT_EQ(v.outliers, 1);
+  ASSERT_EQ(v.rows.size(), 39u);
+  EXPECT_EQ(std::count(v.rows.begin(), v.rows.end(), 17), 0);
+  EXPECT_LT(AngleDeg(v.direction, up), 0.1);
+  EXPECT_GT(v.sigma_deg, 0.05);
+  EXPECT_LT(v.sigma_deg, 0.3);
+  EXPECT_GE(v.inflation, 1.0);
+  // No VP near up: nothing selected.
+  const VerticalSelection none =
+      SelectVertical(kf, {{0, Eigen::Vector3d::UnitZ()}}, up, 10.0, 1.0, 0.05);
+  EXPECT_EQ(none.candidates, 0);
+  EXPECT_TRUE(none.rows.empty());
+}
+
+// Errors shared by neighbouring keyframes (the same edges seen twice) inflate sigma; independent
+// ones barely do.
+TEST(VpPriors, SelectVerticalInflatesSigmaForCorrelatedErrors) {
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.2 * M_PI / 180.0);
+  const Eigen::Vector3d up(0, -1, 0);
+  Trajectory kf;
+  std::vector<VpRay> independent, correlated;
+  Eigen::Vector3d shared = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 200; ++i) {
+    kf.Append(i, Rigid3d());
+    const Eigen::Vector3d e(noise(rng), 0.0, noise(rng));
+    independent.push_back({i, (up + e).normalized()});
+    if (i % 8 == 0) shared = e;  // the same error for 8 keyframes in a row
+    correlated.push_back({i, (up + shared).normalized()});
+  }
+  const VerticalSelection a = SelectVertical(kf, independent, up, 10.0, 1.0, 0.05);
+  const VerticalSelection b = SelectVertical(kf, correlated, up, 10.0, 1.0, 0.05);
+  EXPECT_LT(a.rho, 0.2);
+  EXPECT_GT(b.rho, 0.7);
+  EXPECT_GT(b.inflation, 2.0 * a.inflation);
 }
 
 }  // namespace

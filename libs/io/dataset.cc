@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/check.h"
@@ -25,6 +26,16 @@ DatasetFormat ParseDatasetFormat(const std::string& name) {
   if (name == "kitti") return DatasetFormat::kKittiOdometry;
   if (name == "kitti-raw") return DatasetFormat::kKittiRaw;
   JVL_THROW("--format: unknown dataset format '" << name << "' (auto, kitti, kitti-raw)");
+}
+
+bool ResolveDeskew(const std::string& mode, const Dataset& dataset) {
+  if (mode == "on") return true;
+  if (mode == "off") return false;
+  JVL_CHECK(mode == "auto", "--deskew: expected auto, on or off, got '" << mode << "'");
+  const bool deskew = !dataset.scans_motion_compensated();
+  spdlog::info("{}: scans {}motion-compensated: de-skewing {}", dataset.root(),
+               deskew ? "not " : "", deskew ? "on" : "off");
+  return deskew;
 }
 
 DatasetFormat DetectDatasetFormat(const std::string& dir) {
@@ -137,6 +148,24 @@ cv::Mat LoadImageChecked(const std::string& path, int64_t frame, int camera,
 
 namespace {
 
+// sim_sequence writes its options to sim/scene.json; its scans are raw when it moved the LiDAR
+// during the sweep. A folder without the file (real KITTI odometry) is compensated.
+bool SimulatedWithMotionDistortion(const std::string& scene_path) {
+  if (!FileExists(scene_path)) return false;
+  std::ifstream in(scene_path);
+  const nlohmann::json scene = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  const auto lidar = scene.is_object() ? scene.find("lidar") : scene.end();
+  if (!scene.is_object() || lidar == scene.end() || !lidar->is_object() ||
+      !lidar->contains("motion_distortion") || !(*lidar)["motion_distortion"].is_boolean()) {
+    spdlog::warn(
+        "{}: no boolean lidar.motion_distortion; the scans are taken as "
+        "motion-compensated",
+        scene_path);
+    return false;
+  }
+  return (*lidar)["motion_distortion"].get<bool>();
+}
+
 // ---------------------------------------------------------------------------------------------
 class KittiOdometryDataset : public Dataset {
  public:
@@ -189,6 +218,7 @@ class KittiOdometryDataset : public Dataset {
       ground_truth_files_ = {gt.string()};
     }
     id_ = "kitti:" + name + ":" + HashFiles(KeyFiles());
+    scans_motion_compensated_ = !SimulatedWithMotionDistortion((p / "sim" / "scene.json").string());
   }
 
   PointCloud LoadScan(int64_t frame, size_t* dropped) const override {

@@ -34,6 +34,10 @@ class Dataset {
   const Calibration& calibration() const { return calibration_; }
   // world_from_cam0 of the selected frames when the dataset has ground truth.
   const std::optional<Trajectory>& ground_truth() const { return ground_truth_; }
+  // Whether the scans are motion-compensated (every point in the sensor pose at the frame time).
+  // KITTI odometry: yes (its readme: the ego-motion during the sweep has been compensated);
+  // KITTI raw: no; a sim_sequence folder: as its sim/scene.json says (lidar.motion_distortion).
+  bool scans_motion_compensated() const { return scans_motion_compensated_; }
 
   // LiDAR scan of `frame` in the velodyne frame. Non-finite points are dropped and counted in
   // *dropped (a warning is logged). Throws naming the file on a missing or malformed scan.
@@ -55,9 +59,14 @@ class Dataset {
   std::vector<double> timestamps_;
   Calibration calibration_;
   std::optional<Trajectory> ground_truth_;
+  bool scans_motion_compensated_ = true;
   std::vector<std::string> ground_truth_files_;  // the files ground_truth_ was read from
-  std::string image_size_source_;  // where calibration_'s image size comes from
+  std::string image_size_source_;                // where calibration_'s image size comes from
 };
+
+// --deskew of the tools that read scans: "on", "off" or "auto" (on exactly when the dataset's
+// scans are not motion-compensated). Logs the decision; throws on another value.
+bool ResolveDeskew(const std::string& mode, const Dataset& dataset);
 
 // Opens `dir` (format detected unless given) and selects the frames in `range`.
 std::unique_ptr<Dataset> OpenDataset(const std::string& dir,

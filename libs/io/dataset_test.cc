@@ -18,10 +18,10 @@ namespace fs = std::filesystem;
 const std::string kSeq04 =
     std::string(JVL_SOURCE_DIR) + "/../shared/data/kitti_odometry_04_f0-50/sequences/04";
 
-#define SKIP_WITHOUT_SHARED()                                                          \
-  if (!IsDirectory(kSeq04)) {                                                          \
-    GTEST_SKIP() << "real KITTI data not found at " << kSeq04                          \
-                 << " (../shared/data is only present in the development checkout)";   \
+#define SKIP_WITHOUT_SHARED()                                                        \
+  if (!IsDirectory(kSeq04)) {                                                        \
+    GTEST_SKIP() << "real KITTI data not found at " << kSeq04                        \
+                 << " (../shared/data is only present in the development checkout)"; \
   }
 
 TEST(KittiOdometryTest, ReadsSequence04Frames0To50) {
@@ -123,6 +123,29 @@ TEST_F(BadDatasetTest, ReadsTheGoodFolder) {
   EXPECT_EQ(c.points[1], Eigen::Vector3d(4, 5, 6));
   EXPECT_FLOAT_EQ(c.intensity[0], 0.5f);
   EXPECT_FALSE(ds->ground_truth().has_value());
+}
+
+// KITTI odometry scans are motion-compensated; a sim_sequence folder says in sim/scene.json.
+TEST_F(BadDatasetTest, MotionCompensationFromTheSimulatorsSceneAndDeskewModes) {
+  EXPECT_TRUE(OpenDataset(seq_.string())->scans_motion_compensated());
+  fs::create_directories(seq_ / "sim");
+  std::ofstream((seq_ / "sim" / "scene.json").string())
+      << R"({"lidar": {"motion_distortion": true}})";
+  const auto raw = OpenDataset(seq_.string());
+  EXPECT_FALSE(raw->scans_motion_compensated());
+  EXPECT_TRUE(ResolveDeskew("auto", *raw));
+  EXPECT_FALSE(ResolveDeskew("off", *raw));
+  std::ofstream((seq_ / "sim" / "scene.json").string())
+      << R"({"lidar": {"motion_distortion": false}})";
+  const auto compensated = OpenDataset(seq_.string());
+  EXPECT_TRUE(compensated->scans_motion_compensated());
+  EXPECT_FALSE(ResolveDeskew("auto", *compensated));
+  EXPECT_TRUE(ResolveDeskew("on", *compensated));
+  EXPECT_NE(ErrorOf([&] { ResolveDeskew("yes", *compensated); }).find("auto, on or off"),
+            std::string::npos);
+  // An unreadable scene file is logged and taken as compensated, not an error.
+  std::ofstream((seq_ / "sim" / "scene.json").string()) << "{not json";
+  EXPECT_TRUE(OpenDataset(seq_.string())->scans_motion_compensated());
 }
 
 TEST_F(BadDatasetTest, OddSizedBinNamesTheFile) {

@@ -19,8 +19,9 @@ namespace jvl::io {
 
 OxtsPacket ParseOxtsPacket(const std::string& text, const std::string& name) {
   const auto tokens = SplitWhitespace(text);
-  JVL_CHECK(tokens.size() >= 6, name << ": OXTS packet has " << tokens.size()
-                                     << " values, expected 30 (at least lat lon alt roll pitch yaw)");
+  JVL_CHECK(tokens.size() >= 6,
+            name << ": OXTS packet has " << tokens.size()
+                 << " values, expected 30 (at least lat lon alt roll pitch yaw)");
   double v[6];
   for (int i = 0; i < 6; ++i) {
     const auto d = ParseDouble(tokens[i]);
@@ -38,9 +39,9 @@ std::vector<Rigid3d> OxtsToImuPoses(const std::vector<OxtsPacket>& packets) {
   Rigid3d first_inv;
   for (size_t i = 0; i < packets.size(); ++i) {
     const OxtsPacket& p = packets[i];
-    const Eigen::Vector3d t(scale * p.lon * M_PI * kEarthRadius / 180.0,
-                            scale * kEarthRadius * std::log(std::tan((90.0 + p.lat) * M_PI / 360.0)),
-                            p.alt);
+    const Eigen::Vector3d t(
+        scale * p.lon * M_PI * kEarthRadius / 180.0,
+        scale * kEarthRadius * std::log(std::tan((90.0 + p.lat) * M_PI / 360.0)), p.alt);
     const Eigen::Matrix3d r = (Eigen::AngleAxisd(p.yaw, Eigen::Vector3d::UnitZ()) *
                                Eigen::AngleAxisd(p.pitch, Eigen::Vector3d::UnitY()) *
                                Eigen::AngleAxisd(p.roll, Eigen::Vector3d::UnitX()))
@@ -124,6 +125,7 @@ class KittiRawDataset : public Dataset {
  public:
   KittiRawDataset(const std::string& dir, const FrameRange& range) {
     format_ = DatasetFormat::kKittiRaw;
+    scans_motion_compensated_ = false;  // the raw readme: points must be untwisted
     root_ = dir;
     const fs::path p = fs::path(dir);
     const fs::path drive = p.filename().empty() ? p.parent_path() : p;
@@ -161,15 +163,16 @@ class KittiRawDataset : public Dataset {
     SelectFrames(all, range, dir, &frames_);
 
     // Timestamps of the LiDAR (or camera) stream, relative to the first line.
-    const std::string stamps = (drive / (scans_.empty() ? "image_00" : "velodyne_points") /
-                                "timestamps.txt").string();
+    const std::string stamps =
+        (drive / (scans_.empty() ? "image_00" : "velodyne_points") / "timestamps.txt").string();
     if (FileExists(stamps)) {
       const auto lines = ReadLines(stamps);
-      JVL_CHECK(static_cast<int64_t>(lines.size()) > all.back(),
-                stamps << ": " << lines.size() << " timestamps but the drive has frame "
-                       << all.back());
+      JVL_CHECK(
+          static_cast<int64_t>(lines.size()) > all.back(),
+          stamps << ": " << lines.size() << " timestamps but the drive has frame " << all.back());
       const double t0 = ParseKittiRawTimestamp(lines.front(), stamps);
-      for (int64_t f : frames_) timestamps_.push_back(ParseKittiRawTimestamp(lines[f], stamps) - t0);
+      for (int64_t f : frames_)
+        timestamps_.push_back(ParseKittiRawTimestamp(lines[f], stamps) - t0);
     } else {
       spdlog::warn("{}: no timestamps.txt, assuming 10 Hz", dir);
       for (int64_t f : frames_) timestamps_.push_back(0.1 * f);
@@ -197,7 +200,8 @@ class KittiRawDataset : public Dataset {
       Trajectory gt;
       for (size_t i = 0; i < frames_.size(); ++i) {
         const auto it = std::lower_bound(ids.begin(), ids.end(), frames_[i]);
-        JVL_CHECK(it != ids.end() && *it == frames_[i], dir << ": no OXTS packet for frame " << frames_[i]);
+        JVL_CHECK(it != ids.end() && *it == frames_[i],
+                  dir << ": no OXTS packet for frame " << frames_[i]);
         const Rigid3d& pose = imu0_from_imu[static_cast<size_t>(it - ids.begin())];
         gt.Append(frames_[i], cam0_from_imu * pose * imu_from_cam0, timestamps_[i]);
       }
@@ -242,8 +246,8 @@ double ParseKittiRawTimestamp(const std::string& text, const std::string& name) 
   int y = 0, mo = 0, d = 0, h = 0, mi = 0;
   char frac[32] = {0};
   int sec = 0;
-  const int n = std::sscanf(s.c_str(), "%4d-%2d-%2d %2d:%2d:%2d.%31[0-9]", &y, &mo, &d, &h, &mi,
-                            &sec, frac);
+  const int n =
+      std::sscanf(s.c_str(), "%4d-%2d-%2d %2d:%2d:%2d.%31[0-9]", &y, &mo, &d, &h, &mi, &sec, frac);
   JVL_CHECK(n >= 6 && mo >= 1 && mo <= 12 && d >= 1 && d <= 31,
             name << ": bad timestamp '" << s << "' (expected YYYY-MM-DD HH:MM:SS.fffffffff)");
   const int64_t days = DaysFromCivil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d));

@@ -8,18 +8,6 @@
 #include "core/timer.h"
 
 namespace jvl::lidar {
-namespace {
-
-// Constant velocity within the scan: a point taken at fraction s of the period was seen from
-// cur_from_sensor(s) = Exp(s Log(prev_from_cur)).
-void Deskew(const Rigid3d& prev_from_cur, PreprocessedScan* scan) {
-  const Vector6d xi = LogSE3(prev_from_cur);
-  for (size_t i = 0; i < scan->points.size(); ++i) {
-    scan->points[i] = ExpSE3(static_cast<double>(scan->time_fraction[i]) * xi) * scan->points[i];
-  }
-}
-
-}  // namespace
 
 void OdometryOptions::Check() const {
   preprocess.Check();
@@ -127,7 +115,7 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
   d.points_after_filter = static_cast<int64_t>(pre.points.size());
   d.preprocess_ms = timer.ElapsedMs();
   const Rigid3d motion = PredictMotion();
-  if (options_.deskew && frames_.size() >= 2) Deskew(motion, &pre);
+  if (options_.deskew && frames_.size() >= 2) DeskewScan(motion, &pre);
   const ScanSurface surface = ComputeSurface(pre.points, options_.surface, threads_);
   d.surface_ms = timer.ElapsedMs() - d.preprocess_ms;
 

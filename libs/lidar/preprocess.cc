@@ -96,6 +96,13 @@ void CorrectVerticalAngle(double angle_rad, std::vector<Eigen::Vector3d>* velo_p
   }
 }
 
+void DeskewScan(const Rigid3d& prev_from_cur, PreprocessedScan* scan) {
+  const Vector6d xi = LogSE3(prev_from_cur);
+  for (size_t i = 0; i < scan->points.size(); ++i) {
+    scan->points[i] = ExpSE3(static_cast<double>(scan->time_fraction[i]) * xi) * scan->points[i];
+  }
+}
+
 float AzimuthTimeFraction(const Eigen::Vector3d& velo_point) {
   return static_cast<float>(-std::atan2(velo_point.y(), velo_point.x()) / (2 * kPi));
 }

@@ -66,6 +66,13 @@ struct PreprocessedScan {
 PreprocessedScan PreprocessScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
                                 const PreprocessOptions& options, int threads = 1);
 
+// Constant-velocity de-skewing: `prev_from_cur` is the motion over one scan period in the scan's
+// cam0 frame; a point taken at time fraction s (PreprocessedScan::time_fraction) was seen from
+// cur_from_sensor(s) = Exp(s Log(prev_from_cur)) and is moved there, so every point is in the
+// frame-time pose. Raw scans (KITTI raw, sim_sequence --motion-distortion) need it; the KITTI
+// odometry scans are compensated already (io::Dataset::scans_motion_compensated).
+void DeskewScan(const Rigid3d& prev_from_cur, PreprocessedScan* scan);
+
 // The single steps, exposed for tests and for the mapping stages. Each returns a keep mask or
 // labels over `points` (cam0 frame unless stated otherwise).
 // Raises each point's elevation by `angle_rad` (rotation about p x z_velo), velodyne frame.

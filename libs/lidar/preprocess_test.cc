@@ -25,6 +25,23 @@ void AddGround(double half, double step, std::vector<Eigen::Vector3d>* pts) {
   }
 }
 
+// A sensor moving at constant velocity sees a fixed world point p from the pose at its time
+// fraction s: cur_from_sensor(s) = Exp(s xi). De-skewing brings every observation back to p.
+TEST(PreprocessTest, DeskewUndoesConstantVelocityMotion) {
+  const Rigid3d prev_from_cur(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Eigen::Vector3d(0.1, 1.0, 0.0).normalized())),
+      Eigen::Vector3d(0.1, 0.0, 1.2));
+  const Vector6d xi = LogSE3(prev_from_cur);
+  const Eigen::Vector3d p(3.0, -1.0, 12.0);
+  PreprocessedScan scan;
+  for (const float s : {-0.5f, -0.2f, 0.0f, 0.3f, 0.5f}) {
+    scan.points.push_back(ExpSE3(static_cast<double>(s) * xi).Inverse() * p);
+    scan.time_fraction.push_back(s);
+  }
+  DeskewScan(prev_from_cur, &scan);
+  for (const Eigen::Vector3d& q : scan.points) EXPECT_LT((q - p).norm(), 1e-6);
+}
+
 TEST(PreprocessTest, RangeCutDropsNearPointsAndNaN) {
   PointCloud scan;
   scan.points = {{3, 0, 0}, {0, 4.9, 0}, {6, 0, 0}, {0, 0, 5.1}, {20, 1, 1}};

@@ -103,9 +103,10 @@ namespace {
 
 // Shared by the fixed and the free form: residual and Jacobians w.r.t. the pose quaternion
 // (2 x 4) and the world direction (2 x 3) of r = s (v - pi(+-R_wn^T d_w)).
-bool EvaluateDirection(const PinholeCamera& camera, const Eigen::Vector2d& vp, double s,
-                       double min_z, const double* pose, const Eigen::Vector3d& d_w,
-                       double* residuals, double* jac_pose, double* jac_direction) {
+bool EvaluateDirection(const PinholeCamera& camera, const Eigen::Vector2d& vp,
+                       const Eigen::Vector2d& s, double min_z, const double* pose,
+                       const Eigen::Vector3d& d_w, double* residuals, double* jac_pose,
+                       double* jac_direction) {
   const Eigen::Map<const Eigen::Quaterniond> q_wc(pose);
   Eigen::Vector3d d = q_wc.conjugate() * d_w;
   const double sign = d.z() < 0 ? -1.0 : 1.0;
@@ -113,10 +114,12 @@ bool EvaluateDirection(const PinholeCamera& camera, const Eigen::Vector2d& vp, d
   const bool clamped = d.z() < min_z;
   if (clamped) d.z() = min_z;
   const double inv_z = 1.0 / d.z();
-  residuals[0] = s * (vp.x() - (camera.fx * d.x() * inv_z + camera.cx));
-  residuals[1] = s * (vp.y() - (camera.fy * d.y() * inv_z + camera.cy));
+  residuals[0] = s.x() * (vp.x() - (camera.fx * d.x() * inv_z + camera.cx));
+  residuals[1] = s.y() * (vp.y() - (camera.fy * d.y() * inv_z + camera.cy));
   if (jac_pose == nullptr && jac_direction == nullptr) return true;
-  Eigen::Matrix<double, 2, 3> dr_dd = PixelResidualJacobian(camera.fx, camera.fy, s, d);
+  Eigen::Matrix<double, 2, 3> dr_dd = PixelResidualJacobian(camera.fx, camera.fy, 1.0, d);
+  dr_dd.row(0) *= s.x();
+  dr_dd.row(1) *= s.y();
   if (clamped) dr_dd.col(2).setZero();
   if (jac_pose != nullptr) {
     Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jac_pose);
@@ -134,18 +137,50 @@ bool EvaluateDirection(const PinholeCamera& camera, const Eigen::Vector2d& vp, d
 
 bool DirectionProjectionAnalyticCost::Evaluate(double const* const* parameters, double* residuals,
                                                double** jacobians) const {
-  return EvaluateDirection(camera_, vp_, sqrt_information_, min_z_, parameters[0],
-                           direction_world_, residuals,
-                           jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
+  return EvaluateDirection(camera_, vp_, sqrt_information_, min_z_, parameters[0], direction_world_,
+                           residuals, jacobians != nullptr ? jacobians[0] : nullptr, nullptr);
 }
 
 // The direction block is kept unit by its sphere manifold; it is used as stored.
 bool DirectionProjectionFreeCost::Evaluate(double const* const* parameters, double* residuals,
                                            double** jacobians) const {
   const Eigen::Map<const Eigen::Vector3d> d_w(parameters[1]);
-  return EvaluateDirection(camera_, vp_, sqrt_information_, min_z_, parameters[0], d_w,
-                           residuals, jacobians != nullptr ? jacobians[0] : nullptr,
+  return EvaluateDirection(camera_, vp_, sqrt_information_, min_z_, parameters[0], d_w, residuals,
+                           jacobians != nullptr ? jacobians[0] : nullptr,
                            jacobians != nullptr ? jacobians[1] : nullptr);
+}
+
+DirectionAngleFreeCost::DirectionAngleFreeCost(const Eigen::Vector3d& ray_cam,
+                                               double sqrt_information)
+    : ray_(ray_cam.normalized()), sqrt_information_(sqrt_information) {
+  // Any unit vector not parallel to the ray gives the first tangent axis.
+  const Eigen::Vector3d helper =
+      std::abs(ray_.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  basis_.col(0) = ray_.cross(helper).normalized();
+  basis_.col(1) = ray_.cross(basis_.col(0));
+}
+
+bool DirectionAngleFreeCost::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  const double* pose = parameters[0];
+  const Eigen::Map<const Eigen::Quaterniond> q_wc(pose);
+  const Eigen::Map<const Eigen::Vector3d> d_w(parameters[1]);
+  const Eigen::Vector3d d = q_wc.conjugate() * d_w;
+  const double s = (ray_.dot(d) < 0 ? -1.0 : 1.0) * sqrt_information_;
+  const Eigen::Matrix<double, 2, 3> bt = s * basis_.transpose();
+  Eigen::Map<Eigen::Vector2d> r(residuals);
+  r = bt * d;
+  if (jacobians == nullptr) return true;
+  if (jacobians[0] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 7, Eigen::RowMajor>> j(jacobians[0]);
+    j.leftCols<4>() = bt * InverseRotateJacobian(pose, d_w);
+    j.rightCols<3>().setZero();
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> j(jacobians[1]);
+    j = bt * q_wc.conjugate().toRotationMatrix();
+  }
+  return true;
 }
 
 }  // namespace jvl::optim

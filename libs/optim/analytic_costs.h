@@ -73,8 +73,8 @@ class PointToImlsAnalyticCost : public ceres::SizedCostFunction<1, 7, 7> {
 class DirectionProjectionAnalyticCost : public ceres::SizedCostFunction<2, 7> {
  public:
   DirectionProjectionAnalyticCost(const PinholeCamera& camera, const Eigen::Vector2d& vp,
-                                  const Eigen::Vector3d& direction_world, double sqrt_information,
-                                  double min_z)
+                                  const Eigen::Vector3d& direction_world,
+                                  const Eigen::Vector2d& sqrt_information, double min_z)
       : camera_(camera),
         vp_(vp),
         direction_world_(direction_world.normalized()),
@@ -88,7 +88,7 @@ class DirectionProjectionAnalyticCost : public ceres::SizedCostFunction<2, 7> {
   const PinholeCamera camera_;
   const Eigen::Vector2d vp_;
   const Eigen::Vector3d direction_world_;
-  const double sqrt_information_;
+  const Eigen::Vector2d sqrt_information_;  // per image axis (u, v)
   const double min_z_;
 };
 
@@ -98,7 +98,7 @@ class DirectionProjectionAnalyticCost : public ceres::SizedCostFunction<2, 7> {
 class DirectionProjectionFreeCost : public ceres::SizedCostFunction<2, 7, 3> {
  public:
   DirectionProjectionFreeCost(const PinholeCamera& camera, const Eigen::Vector2d& vp,
-                              double sqrt_information, double min_z)
+                              const Eigen::Vector2d& sqrt_information, double min_z)
       : camera_(camera), vp_(vp), sqrt_information_(sqrt_information), min_z_(min_z) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
@@ -107,8 +107,26 @@ class DirectionProjectionFreeCost : public ceres::SizedCostFunction<2, 7, 3> {
  private:
   const PinholeCamera camera_;
   const Eigen::Vector2d vp_;
-  const double sqrt_information_;
+  const Eigen::Vector2d sqrt_information_;  // per image axis (u, v)
   const double min_z_;
+};
+
+// A direction observed as a ray (a vanishing direction that may lie at infinity in the image,
+// e.g. the vertical VP of a level camera) against a free world direction d_w (unit sphere
+// block): r = s sign B^T R_wn^T d_w, B an orthonormal basis of the plane normal to the observed
+// unit ray (its tangent plane), sign = that of ray . R_wn^T d_w (unoriented). Near the
+// solution |r| / s is the angle between the ray and R_wn^T d_w (radians); s = 1 / sigma (rad).
+class DirectionAngleFreeCost : public ceres::SizedCostFunction<2, 7, 3> {
+ public:
+  DirectionAngleFreeCost(const Eigen::Vector3d& ray_cam, double sqrt_information);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Eigen::Vector3d ray_;
+  Eigen::Matrix<double, 3, 2> basis_;  // orthonormal, normal to ray_
+  const double sqrt_information_;
 };
 
 }  // namespace jvl::optim

@@ -90,7 +90,8 @@ TEST(VisualReprojectionAnalyticCost, MatchesAutodiffAndNumericAndFailsBehindTheC
   PoseBlock pose = ToPoseBlock(world_from_cam);
   const double* params[2] = {pose.data(), behind.data()};
   double r[2];
-  EXPECT_FALSE(VisualReprojectionAnalyticCost(camera, {600, 180}, 1.0).Evaluate(params, r, nullptr));
+  EXPECT_FALSE(
+      VisualReprojectionAnalyticCost(camera, {600, 180}, 1.0).Evaluate(params, r, nullptr));
 }
 
 TEST(PointToImlsAnalyticCost, MatchesAutodiffAndNumeric) {
@@ -111,6 +112,9 @@ TEST(PointToImlsAnalyticCost, MatchesAutodiffAndNumeric) {
   }
 }
 
+// e_D's whitening per image axis (u, v), different on purpose so a swapped axis shows.
+const Eigen::Vector2d kSqrtInfo(0.5, 0.8);
+
 TEST(DirectionProjectionAnalyticCost, MatchesAutodiffAndNumericIncludingGuards) {
   std::mt19937 rng(7);
   const PinholeCamera camera = KittiLikeCamera();
@@ -122,9 +126,9 @@ TEST(DirectionProjectionAnalyticCost, MatchesAutodiffAndNumericIncludingGuards) 
     const Eigen::Vector3d d_w = world_from_cam.rotation() * d_cam.normalized();
     const Eigen::Vector2d vp(650.0, 170.0);
     PoseBlock pose = ToPoseBlock(world_from_cam);
-    DirectionProjectionAnalyticCost analytic(camera, vp, d_w, 0.5, 0.05);
+    DirectionProjectionAnalyticCost analytic(camera, vp, d_w, kSqrtInfo, 0.05);
     std::unique_ptr<ceres::CostFunction> autodiff(
-        DirectionProjectionCost::Create(camera, vp, d_w, 0.5, 0.05));
+        DirectionProjectionCost::Create(camera, vp, d_w, kSqrtInfo, 0.05));
     ExpectSameEvaluation(analytic, *autodiff, {pose.data()});
     EXPECT_LT(LocalJacobianError(analytic, {true}, {pose.data()}), 1e-5) << d_cam.transpose();
     // With the clamp active (residual ~1e4 px, true derivative ~1e2) ceres::GradientChecker's
@@ -151,8 +155,8 @@ TEST(DirectionProjectionFreeCost, MatchesTheFixedFormAndNumeric) {
     const Eigen::Vector2d vp(650.0, 170.0);
     PoseBlock pose = ToPoseBlock(world_from_cam);
     std::array<double, 3> dir = {d_w.x(), d_w.y(), d_w.z()};
-    DirectionProjectionFreeCost free(camera, vp, 0.5, 0.05);
-    DirectionProjectionAnalyticCost fixed(camera, vp, d_w, 0.5, 0.05);
+    DirectionProjectionFreeCost free(camera, vp, kSqrtInfo, 0.05);
+    DirectionProjectionAnalyticCost fixed(camera, vp, d_w, kSqrtInfo, 0.05);
     double r_free[2], r_fixed[2], j_pose_free[14], j_dir[6], j_pose_fixed[14];
     double* jf[2] = {j_pose_free, j_dir};
     double* jx[1] = {j_pose_fixed};
@@ -167,6 +171,45 @@ TEST(DirectionProjectionFreeCost, MatchesTheFixedFormAndNumeric) {
     // Translation columns are exactly zero: e_D constrains the rotation only.
     for (int row = 0; row < 2; ++row)
       for (int col = 4; col < 7; ++col) EXPECT_EQ(j_pose_free[row * 7 + col], 0.0);
+  }
+}
+
+// The ray form of e_D: zero where the ray is R_wn^T d_w (either sign), |r| / s equals the angle
+// for a small rotation away, and both Jacobians match numeric differences, also for a vertical
+// ray (a VP at infinity in the image, where the pixel form cannot be used).
+TEST(DirectionAngleFreeCost, ZeroOnTheRayAngleMagnitudeAndJacobians) {
+  std::mt19937 rng(9);
+  for (const Eigen::Vector3d& ray :
+       {Eigen::Vector3d(0.0, -1.0, 0.0), Eigen::Vector3d(0.01, -1.0, 0.004),
+        Eigen::Vector3d(0.1, 0.05, 1.0), Eigen::Vector3d(1.0, 0.0, 0.0)}) {
+    const Rigid3d world_from_cam = RandomPose(rng, 0.4, 5.0);
+    const Eigen::Vector3d d_w = world_from_cam.rotation() * ray.normalized();
+    PoseBlock pose = ToPoseBlock(world_from_cam);
+    const double s = 2.0;
+    DirectionAngleFreeCost cost(ray, s);
+    double r[2];
+    for (const double sign : {1.0, -1.0}) {
+      std::array<double, 3> dir = {sign * d_w.x(), sign * d_w.y(), sign * d_w.z()};
+      const double* p[2] = {pose.data(), dir.data()};
+      ASSERT_TRUE(cost.Evaluate(p, r, nullptr));
+      EXPECT_NEAR(r[0], 0.0, 1e-12);
+      EXPECT_NEAR(r[1], 0.0, 1e-12);
+    }
+    // d_w turned by 0.01 rad about an axis normal to it.
+    const Eigen::Vector3d axis = d_w.unitOrthogonal();
+    const Eigen::Vector3d turned = Eigen::AngleAxisd(0.01, axis) * d_w;
+    std::array<double, 3> dir = {turned.x(), turned.y(), turned.z()};
+    const double* p[2] = {pose.data(), dir.data()};
+    ASSERT_TRUE(cost.Evaluate(p, r, nullptr));
+    EXPECT_NEAR(std::hypot(r[0], r[1]) / s, 0.01, 1e-6);
+    std::string log;
+    EXPECT_LT(CheckGradient(cost, {true, false}, {pose.data(), dir.data()}, &log), 1e-5) << log;
+    // Translation columns are exactly zero: the ray constrains the rotation only.
+    double j_pose[14], j_dir[6];
+    double* j[2] = {j_pose, j_dir};
+    ASSERT_TRUE(cost.Evaluate(p, r, j));
+    for (int row = 0; row < 2; ++row)
+      for (int col = 4; col < 7; ++col) EXPECT_EQ(j_pose[row * 7 + col], 0.0);
   }
 }
 

@@ -111,8 +111,8 @@ class PointToImlsCost {
 class DirectionProjectionCost {
  public:
   DirectionProjectionCost(const PinholeCamera& camera, const Eigen::Vector2d& vp,
-                          const Eigen::Vector3d& direction_world, double sqrt_information,
-                          double min_z)
+                          const Eigen::Vector3d& direction_world,
+                          const Eigen::Vector2d& sqrt_information, double min_z)
       : camera_(camera),
         vp_(vp),
         direction_world_(direction_world.normalized()),
@@ -127,14 +127,14 @@ class DirectionProjectionCost {
     if (d_n.z() < T(min_z_)) d_n.z() = T(min_z_);
     T uv[2];
     ProjectPinhole(camera_, d_n, uv);
-    residual[0] = T(sqrt_information_) * (T(vp_.x()) - uv[0]);
-    residual[1] = T(sqrt_information_) * (T(vp_.y()) - uv[1]);
+    residual[0] = T(sqrt_information_.x()) * (T(vp_.x()) - uv[0]);
+    residual[1] = T(sqrt_information_.y()) * (T(vp_.y()) - uv[1]);
     return true;
   }
 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& vp,
                                      const Eigen::Vector3d& direction_world,
-                                     double sqrt_information, double min_z) {
+                                     const Eigen::Vector2d& sqrt_information, double min_z) {
     return new ceres::AutoDiffCostFunction<DirectionProjectionCost, 2, 7>(
         new DirectionProjectionCost(camera, vp, direction_world, sqrt_information, min_z));
   }
@@ -143,7 +143,7 @@ class DirectionProjectionCost {
   const PinholeCamera camera_;
   const Eigen::Vector2d vp_;
   const Eigen::Vector3d direction_world_;
-  const double sqrt_information_;
+  const Eigen::Vector2d sqrt_information_;  // per image axis (u, v)
   const double min_z_;
 };
 

@@ -130,14 +130,14 @@ TEST(DirectionProjectionCost, ZeroWhenDirectionProjectsOntoVp) {
   const Eigen::Vector3d d_w = world_from_cam.rotation() * d_cam;
   const Eigen::Vector2d vp = camera.Project(d_cam);
   std::unique_ptr<ceres::CostFunction> cost(
-      DirectionProjectionCost::Create(camera, vp, d_w, 0.5, 0.05));
+      DirectionProjectionCost::Create(camera, vp, d_w, Eigen::Vector2d(0.5, 0.5), 0.05));
   PoseBlock pose = ToPoseBlock(world_from_cam);
   std::vector<double> r = Residuals(*cost, {pose.data()});
   EXPECT_NEAR(r[0], 0.0, 1e-9);
   EXPECT_NEAR(r[1], 0.0, 1e-9);
   // The opposite (unoriented) direction has the same vanishing point.
   std::unique_ptr<ceres::CostFunction> flipped(
-      DirectionProjectionCost::Create(camera, vp, -d_w, 0.5, 0.05));
+      DirectionProjectionCost::Create(camera, vp, -d_w, Eigen::Vector2d(0.5, 0.5), 0.05));
   r = Residuals(*flipped, {pose.data()});
   EXPECT_NEAR(r[0], 0.0, 1e-9);
   // Translation does not matter at all.
@@ -151,8 +151,8 @@ TEST(DirectionProjectionCost, ZeroWhenDirectionProjectsOntoVp) {
 TEST(DirectionProjectionCost, YawSignTranslationDerivativeZeroAndJacobianMatches) {
   const PinholeCamera camera = KittiLikeCamera();
   const Eigen::Vector3d d_w = Eigen::Vector3d::UnitZ();  // straight ahead
-  std::unique_ptr<ceres::CostFunction> cost(
-      DirectionProjectionCost::Create(camera, {camera.cx, camera.cy}, d_w, 1.0, 0.05));
+  std::unique_ptr<ceres::CostFunction> cost(DirectionProjectionCost::Create(
+      camera, {camera.cx, camera.cy}, d_w, Eigen::Vector2d(1.0, 1.0), 0.05));
   // Camera turned right (rotation by +yaw about its y axis, optical axis towards +x): the road
   // direction appears left of the principal point, predicted u < cx, so r_u = cx - u > 0.
   const double yaw = 0.01;
@@ -172,7 +172,7 @@ TEST(DirectionProjectionCost, YawSignTranslationDerivativeZeroAndJacobianMatches
 TEST(DirectionProjectionCost, FiniteWhenDirectionIsParallelToTheImagePlane) {
   const PinholeCamera camera = KittiLikeCamera();
   std::unique_ptr<ceres::CostFunction> cost(DirectionProjectionCost::Create(
-      camera, {camera.cx, camera.cy}, Eigen::Vector3d::UnitX(), 1.0, 0.05));
+      camera, {camera.cx, camera.cy}, Eigen::Vector3d::UnitX(), Eigen::Vector2d(1.0, 1.0), 0.05));
   PoseBlock pose = ToPoseBlock(Rigid3d());
   std::vector<std::vector<double>> jac;
   const std::vector<double> r = Residuals(*cost, {pose.data()}, &jac);

@@ -222,10 +222,20 @@ void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
 
 void AddDirections(const JointProblemInput& input, const JointProblemOptions& options,
                    ceres::LossFunction* loss, JointProblem& jp) {
-  const double sqrt_info = 1.0 / options.direction_sigma_px;
+  const Eigen::Vector2d sqrt_info(
+      1.0 / options.direction_sigma_px,
+      1.0 / (options.direction_sigma_v_px > 0 ? options.direction_sigma_v_px
+                                              : options.direction_sigma_px));
   for (const DirectionConstraint& d : input.directions) {
     double* pose = jp.poses.at(d.keyframe).data();
     const double min_z = options.direction_min_z;
+    if (d.ray_form) {
+      JVL_CHECK(d.free_direction >= 0, "a ray-form direction constraint needs a free direction");
+      jp.direction_blocks.push_back(jp.problem->AddResidualBlock(
+          new DirectionAngleFreeCost(d.ray, 1.0 / options.direction_sigma_rad), loss, pose,
+          jp.free_directions[static_cast<size_t>(d.free_direction)].data()));
+      continue;
+    }
     if (d.free_direction >= 0) {
       jp.direction_blocks.push_back(jp.problem->AddResidualBlock(
           new DirectionProjectionFreeCost(input.camera, d.vp, sqrt_info, min_z), loss, pose,
@@ -250,6 +260,10 @@ void JointProblemOptions::Check() const {
   JVL_CHECK(beta_scale > 0 && gamma_scale > 0, "beta_scale and gamma_scale must be positive");
   JVL_CHECK(octave_scale_factor >= 1, "octave_scale_factor must be >= 1");
   JVL_CHECK(imls_sigma_m > 0 && direction_sigma_px > 0, "residual sigmas must be positive");
+  JVL_CHECK(std::isfinite(direction_sigma_rad) && direction_sigma_rad > 0,
+            "direction_sigma_rad must be positive");
+  JVL_CHECK(std::isfinite(direction_sigma_v_px) && direction_sigma_v_px >= 0,
+            "direction_sigma_v_px must be >= 0 (0: as direction_sigma_px)");
   JVL_CHECK(direction_min_z > 0 && direction_min_z < 1, "direction_min_z must be in (0, 1)");
   JVL_CHECK(std::isfinite(visual_gate_chi2), "visual_gate_chi2 must be finite");
   JVL_CHECK(std::isfinite(max_point_sigma_ratio), "max_point_sigma_ratio must be finite");

@@ -56,11 +56,16 @@ std::vector<ImlsPair> AggregateImls(const std::vector<ImlsCorrespondence>& corre
 // A vanishing point v of keyframe `keyframe` associated with a world direction prior d_w (Eq. 6).
 struct DirectionConstraint {
   int64_t keyframe = 0;
-  Eigen::Vector2d vp = Eigen::Vector2d::Zero();  // pixels, finite
+  Eigen::Vector2d vp = Eigen::Vector2d::Zero();                // pixels, finite
   Eigen::Vector3d direction_world = Eigen::Vector3d::UnitZ();  // used if free_direction < 0
   // >= 0: d_w is JointProblemInput::free_directions[free_direction], a unit-sphere parameter
   // block optimised with the poses (shared by the constraints of one direction cluster).
   int32_t free_direction = -1;
+  // Ray form (needs free_direction >= 0): the observation is the unit ray `ray` in the camera
+  // instead of the pixel `vp` (a VP that may lie at infinity in the image, such as the vertical
+  // one), residual DirectionAngleFreeCost whitened by JointProblemOptions::direction_sigma_rad.
+  bool ray_form = false;
+  Eigen::Vector3d ray = Eigen::Vector3d::UnitZ();
 };
 
 struct JointProblemInput {
@@ -98,7 +103,11 @@ struct JointProblemOptions {
   // Noise models (square-root information = 1 / sigma).
   double octave_scale_factor = 1.2;  // ORB-SLAM: sigma_V = 1.2^octave px
   double imls_sigma_m = 0.05;        // e_L in metres
-  double direction_sigma_px = 1.0;   // e_D in pixels
+  double direction_sigma_px = 1.0;   // e_D in pixels (image u; v too unless set below)
+  // e_D's v (image row) component, when it has a noise of its own (> 0): on sloped roads the
+  // VP's row also holds the grade of the road ahead, which varies along one direction prior.
+  double direction_sigma_v_px = 0.0;
+  double direction_sigma_rad = 0.005;  // e_D of ray-form constraints (radians)
   // Huber thresholds on the whitened residual norm; <= 0 disables. ORB-SLAM mono: sqrt(5.991).
   double visual_huber = 2.447651936039926;
   double imls_huber = 0.0;
@@ -150,7 +159,7 @@ struct JointProblem {
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks;
   std::vector<int64_t> imls_block_counts;  // correspondences in each of imls_blocks
-  std::set<int64_t> fixed;  // effective constant poses (gauge)
+  std::set<int64_t> fixed;                 // effective constant poses (gauge)
   JointWeights weights;
   int64_t dropped_observations = 0;  // behind the camera at the initial estimate
   // Left out by visual_gate_chi2: observations above the gate, and the other observations of
@@ -170,7 +179,7 @@ struct SolveOptions {
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
-  double max_time_s = 1e9;  // a wall-clock limit makes results machine-dependent: tests only
+  double max_time_s = 1e9;    // a wall-clock limit makes results machine-dependent: tests only
   bool log_progress = false;  // Ceres' per-iteration log on stderr
   // Non-empty: one info log line per LM iteration ("<label> iteration k: cost, time"), the
   // progress of long solves.
@@ -207,8 +216,8 @@ struct JointSolveResult {
   bool usable = false;      // Ceres returned CONVERGENCE or NO_CONVERGENCE (not FAILURE)
   std::string termination;  // Ceres' summary line
   std::string linear_solver;
-  std::map<int64_t, Rigid3d> poses;         // optimised world_from_cam
-  std::vector<Eigen::Vector3d> map_points;  // optimised (unchanged if not optimised)
+  std::map<int64_t, Rigid3d> poses;              // optimised world_from_cam
+  std::vector<Eigen::Vector3d> map_points;       // optimised (unchanged if not optimised)
   std::vector<Eigen::Vector3d> free_directions;  // optimised free d_w blocks (unit)
 };
 

@@ -47,9 +47,10 @@ void BM_Direction(benchmark::State& state) {
   const PinholeCamera camera = testing::KittiLikeCamera();
   const Eigen::Vector3d d_w(0.1, 0, 1);
   std::unique_ptr<ceres::CostFunction> cost(
-      state.range(0) ? static_cast<ceres::CostFunction*>(
-                           new DirectionProjectionAnalyticCost(camera, {600, 180}, d_w, 1.0, 0.05))
-                     : DirectionProjectionCost::Create(camera, {600, 180}, d_w, 1.0, 0.05));
+      state.range(0) ? static_cast<ceres::CostFunction*>(new DirectionProjectionAnalyticCost(
+                           camera, {600, 180}, d_w, Eigen::Vector2d(1.0, 1.0), 0.05))
+                     : DirectionProjectionCost::Create(camera, {600, 180}, d_w,
+                                                       Eigen::Vector2d(1.0, 1.0), 0.05));
   EvaluateLoop(state, *cost, {pose.data()});
 }
 BENCHMARK(BM_Direction)->ArgName("analytic")->Arg(0)->Arg(1);

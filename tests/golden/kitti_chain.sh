@@ -30,7 +30,7 @@ frames=(--frames 0:20)
 "$bin/visual_assoc" --dataset "$seq" "${frames[@]}" --prior odom.h5 --directions directions.h5 \
   -o visual.h5 --quiet "${common[@]}" > /dev/null
 "$bin/local_map" --visual visual.h5 --dataset "$seq" -o local.h5 --quiet "${common[@]}" > /dev/null
-"$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 -o global.h5 \
+"$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 --vps vps.h5 -o global.h5 \
   "${common[@]}"
 "$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 --no-direction \
   -o global_nodir.h5 "${common[@]}"

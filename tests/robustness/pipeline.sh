@@ -32,7 +32,7 @@ seq=data/sequences/00
   "${common[@]}" > /dev/null
 "$bin/local_map" --visual visual.h5 --dataset "$seq" -o local.h5 --kitti-poses local.txt --quiet \
   "${common[@]}" > /dev/null
-"$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 -o global.h5 \
+"$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 --vps vps.h5 -o global.h5 \
   --kitti-poses global.txt --map map.ply "${common[@]}"
 "$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 --no-direction \
   -o global_nodir.h5 "${common[@]}"

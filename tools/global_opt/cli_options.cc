@@ -9,7 +9,9 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
   app::OptionGroup method(tool, "Method");
   method.Add("--alpha", o->joint.alpha, "Weight of the visual term");
   method.Add("--beta", o->joint.beta, "Weight of e_L (<= 0: from the residual counts)");
-  method.Add("--gamma", o->joint.gamma, "Weight of e_D (<= 0: from the residual counts)");
+  method.Add("--gamma", o->joint.gamma,
+             "Weight of the whitened e_D (1: each residual one measurement of its measured "
+             "noise; <= 0: the paper's rule from the residual counts, N_V / N_D)");
   method.Flag("--no-direction", f->no_direction, "Ablation: no direction projection residuals");
   method.Flag("--no-saved-imls", f->no_saved_imls, "Leave out the saved correspondence set L");
   method.Flag("--no-fresh-imls", f->no_fresh_imls, "Leave out the fresh IMLS traversal");
@@ -36,6 +38,13 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
              "refit/free: smallest gate (deg) for VPs far from their cluster's direction");
   method.Add("--direction-sigma", "direction_sigma_px", o->direction_sigma_px,
              "sigma of e_D in pixels (<= 0: estimated from the VP residuals when e_D enters)");
+  method.Flag("--direction-sigma-per-axis", o->direction_sigma_per_axis,
+              "Estimate e_D's sigma per image axis (u, v): on sloped roads the VP row also "
+              "follows the grade ahead, so its part weighs less");
+  method.Flag("!--no-vertical", o->use_vertical,
+              "Leave out the vertical direction prior of --vps (ablation)");
+  method.Add("--vertical-max-deg", o->vertical_max_deg,
+             "Vertical prior: a VP is a candidate within this angle of the world's up (deg)");
   method.Add("--direction-huber", o->joint.direction_huber,
              "Huber threshold of e_D in sigmas (<= 0: none)");
   method.Add("--visual-gate", o->joint.visual_gate_chi2,

@@ -11,6 +11,7 @@
 #include "io/global_io.h"
 #include "io/ply_io.h"
 #include "io/trajectory_io.h"
+#include "io/vps_io.h"
 #include "mapping/global/global_artifact.h"
 #include "mapping/global/global_mapping.h"
 #include "optim/correction.h"
@@ -20,7 +21,8 @@ int main(int argc, char** argv) {
   app::Tool tool("global_opt",
                  "Global joint optimisation: visual reprojection + point-to-IMLS + direction "
                  "projection errors over all keyframes (Eq. 7), full-rate trajectory and map.");
-  std::string local_path, visual_path, directions_path, prior_path, output, kitti, map_path;
+  std::string local_path, visual_path, directions_path, vps_path, prior_path, output, kitti,
+      map_path;
   double map_voxel = 0.2;
   bool map_ascii = false;
   mapping::GlobalMappingOptions o;  // the library's defaults are the tool's
@@ -30,6 +32,10 @@ int main(int argc, char** argv) {
       cli.add_option("--visual", visual_path, "visual artifact (visual_assoc)")->required());
   tool.InputFile(
       cli.add_option("--directions", directions_path, "directions artifact (direction_cluster)"));
+  tool.InputFile(cli.add_option(
+      "--vps", vps_path,
+      "vps artifact (vp_detect): its vertical VPs give the vertical direction prior, one "
+      "direction shared by the whole drive (with e_D; --no-vertical leaves it out)"));
   tool.InputFile(cli.add_option(
       "--prior", prior_path,
       "Full-rate prior to correct (.h5 artifact, KITTI, TUM); default: local's prior"));
@@ -85,6 +91,11 @@ int main(int argc, char** argv) {
       o.joint.octave_scale_factor = visual.scale_factor;
       input = mapping::AssembleGlobalInput(visual, std::move(local),
                                            directions_path.empty() ? nullptr : &directions);
+      if (!vps_path.empty() && !flags.no_direction && o.use_vertical) {
+        tool.AddInput(vps_path);
+        for (const io::VpRecord& v : io::ReadVpsArtifact(vps_path).vps)
+          input.vp_rays.push_back({v.frame, v.direction});
+      }
     }
     ReleaseFreeHeapMemory();  // what reading the artifacts allocated and freed (core/memory.h)
     spdlog::debug("artifacts read and assembled in {:.1f} s", reading.ElapsedSeconds());

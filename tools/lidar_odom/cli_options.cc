@@ -4,7 +4,7 @@
 
 namespace jvl::tools {
 
-void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options) {
+void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::string* deskew) {
   lidar::OdometryOptions& o = *options;
   app::OptionGroup model(tool, "Model and sampling");
   model.Add("--scan-map-size", o.scan_map_size, "N: scans kept in the model (paper's N)");
@@ -12,7 +12,12 @@ void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options) {
             "s: points per IMLS-SLAM sampling list (x9)");
   model.Add("--initial-search-scale", o.initial_search_scale,
             "Second scan (no velocity yet): coarse pass with neighbourhoods x this (1 = off)");
-  model.Flag("--deskew,!--no-deskew", o.deskew, "Constant-velocity de-skewing of each scan");
+  model
+      .Add("--deskew", *deskew,
+           "Constant-velocity de-skewing of each scan: auto (when the dataset's scans are not "
+           "motion-compensated: KITTI raw, sim_sequence --motion-distortion; KITTI odometry scans "
+           "are compensated), on or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
 
   app::OptionGroup pre(tool, "Preprocessing");
   auto& p = o.preprocess;

@@ -1,11 +1,14 @@
 // Command-line options of lidar_odom: every algorithm parameter of OdometryOptions.
 #pragma once
 
+#include <string>
+
 #include "app/tool.h"
 #include "lidar/odometry.h"
 
 namespace jvl::tools {
 
-void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options);
+// `deskew`: the --deskew mode (auto, on, off), resolved against the dataset (io::ResolveDeskew).
+void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::string* deskew);
 
 }  // namespace jvl::tools

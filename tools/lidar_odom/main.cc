@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   jvl::app::Tool tool("lidar_odom", "IMLS scan-to-model LiDAR odometry (prior trajectory).");
   std::string dataset_dir, format = "auto", frames = ":", output, kitti_poses;
   jvl::lidar::OdometryOptions options;
+  std::string deskew = "auto";
   auto& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
@@ -47,12 +48,13 @@ int main(int argc, char** argv) {
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   tool.OutputFile(cli.add_option("-o,--output", output, "Odometry artifact (.h5)")->required());
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses, "Also write KITTI pose text here"));
-  jvl::tools::AddLidarOdomFlags(tool, &options);
+  jvl::tools::AddLidarOdomFlags(tool, &options, &deskew);
   return tool.Run(argc, argv, [&] {
     options.Check();
     const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
                                               jvl::ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
+    options.deskew = jvl::io::ResolveDeskew(deskew, *dataset);
     jvl::lidar::Odometry odometry(dataset->calibration().cam0_from_velo, options, tool.threads());
     jvl::io::OdometryArtifact artifact;
     const auto& ids = dataset->frames();

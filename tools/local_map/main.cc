@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
                  "Refine keyframe poses and map points by joint visual / point-to-IMLS local "
                  "optimisation of each keyframe.");
   std::string visual_path, dataset_dir, format = "auto", prior_path, output, kitti_poses;
+  std::string deskew = "auto";
   mapping::LocalMappingOptions options;
   mapping::ScanOptions scan_options;
   auto& cli = tool.cli();
@@ -36,6 +37,12 @@ int main(int argc, char** argv) {
       cli.add_option("--visual", visual_path, "visual.h5 from visual_assoc")->required());
   cli.add_option("--dataset", dataset_dir, "Dataset folder (the scans)")->required();
   cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--deskew", deskew,
+                 "Constant-velocity de-skewing of each keyframe's scan with the prior's motion: "
+                 "auto (when the dataset's scans are not motion-compensated: KITTI raw, "
+                 "sim_sequence --motion-distortion), on or off")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   tool.InputFile(
       cli.add_option("--prior", prior_path,
                      "Initial poses (.h5, KITTI or TUM); default: the visual artifact's prior"));
@@ -60,14 +67,17 @@ int main(int argc, char** argv) {
     auto dataset = io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), FrameRange());
     tool.AddDataset(*dataset, dataset_dir);
     const Rigid3d cam0_from_velo = dataset->calibration().cam0_from_velo;
+    const bool deskew_scans = io::ResolveDeskew(deskew, *dataset);
     Progress progress("local_map", static_cast<int64_t>(input.size()), !tool.quiet());
     const mapping::LocalMappingResult result = mapping::RunLocalMapping(
         input,
         [&](size_t row) {
           const PointCloud scan = dataset->LoadScan(input.frames[row]);
-          mapping::KeyframeScan prepared =
-              mapping::PrepareKeyframeScan(scan, cam0_from_velo, scan_options,
-                                           options.association.samples_per_list, tool.threads());
+          const std::optional<Rigid3d> sweep =
+              deskew_scans ? mapping::SweepMotion(prior, input.frames[row]) : std::nullopt;
+          mapping::KeyframeScan prepared = mapping::PrepareKeyframeScan(
+              scan, cam0_from_velo, scan_options, options.association.samples_per_list,
+              tool.threads(), sweep);
           // An empty scan is reported by the dataset; a nearly empty or degenerate one (all
           // points at the origin, a few points) leaves the keyframe's IMLS term weak or empty.
           if (!scan.empty() && prepared.sampled.size() < kFewSurfacePoints) {

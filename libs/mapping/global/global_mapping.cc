@@ -14,6 +14,7 @@
 #include "core/memory.h"
 #include "core/threads.h"
 #include "core/timer.h"
+#include "geometry/angles.h"
 #include "lidar/imls.h"
 #include "lidar/surface.h"
 #include "lidar/voxel_grid.h"
@@ -52,6 +53,10 @@ optim::JointProblemOptions DefaultGlobalJointOptions() {
   optim::JointProblemOptions o;
   o.visual_gate_chi2 = 5.991;     // chi2(2, 0.95)
   o.max_point_sigma_ratio = 0.3;  // hold poorly determined points
+  // e_D is whitened by its measured noise and weighted like one measurement per residual (the
+  // paper's count rule, gamma = N_V / N_D, made it several hundred times heavier and the
+  // direction priors then made every drive of the gains table worse: docs/global_opt.md).
+  o.gamma = 1.0;
   return o;
 }
 
@@ -75,7 +80,8 @@ void GlobalMappingOptions::Check() const {
   solve.Check();
   traversal.Check();
   JVL_CHECK(rounds >= 1, "rounds must be >= 1, got " << rounds);
-  JVL_CHECK(first_direction_round >= 0, "first_direction_round must be >= 0, got " << first_direction_round);
+  JVL_CHECK(first_direction_round >= 0,
+            "first_direction_round must be >= 0, got " << first_direction_round);
   JVL_CHECK(std::isfinite(refit_outlier_deg) && refit_outlier_deg > 0 && refit_outlier_deg < 90,
             "refit_outlier_deg must be in (0, 90) degrees, got " << refit_outlier_deg);
   JVL_CHECK(refit_min_support >= 1, "refit_min_support must be >= 1, got " << refit_min_support);
@@ -121,11 +127,10 @@ int64_t SelectObservations(std::vector<optim::VisualObservation>* observations, 
     ++points;
     for (int64_t k = start[p]; k < start[p + 1]; ++k) ++taken_in[static_cast<size_t>(rows[k])];
   }
-  observations->erase(std::remove_if(observations->begin(), observations->end(),
-                                     [&](const optim::VisualObservation& o) {
-                                       return !taken[o.map_point];
-                                     }),
-                      observations->end());
+  observations->erase(
+      std::remove_if(observations->begin(), observations->end(),
+                     [&](const optim::VisualObservation& o) { return !taken[o.map_point]; }),
+      observations->end());
   observations->shrink_to_fit();
   return points;
 }
@@ -250,8 +255,9 @@ namespace {
 // What stays the same over the rounds of Eq. (7).
 struct FixedTerms {
   direction::DirectionSelection directions;  // e_D's priors as selected from the artifact
-  bool aggregate = false;     // e_L summed per keyframe pair (compressed form)
-  bool summed_saved = false;  // the saved set L given to the problem summed per pair
+  std::vector<direction::VpRay> vp_rays;     // candidates of the vertical prior
+  bool aggregate = false;                    // e_L summed per keyframe pair (compressed form)
+  bool summed_saved = false;                 // the saved set L given to the problem summed per pair
   std::vector<optim::ImlsPair> saved_pairs;  // summed_saved: L summed per keyframe pair
   int64_t saved_count = 0;                   // correspondences in L
   bool fresh = false;                        // a fresh traversal in every round
@@ -264,6 +270,7 @@ struct DirectionTerm {
   std::vector<direction::VpPrior> priors;  // d_w as it was when e_D entered
   std::vector<optim::DirectionConstraint> constraints;
   std::vector<Eigen::Vector3d> free_directions;  // kFree: current d_w of each kept cluster
+  int vertical_block = -1;  // index of the vertical prior's direction in free_directions
 };
 
 // e_V (Eq. 5): the subset of the map points of GlobalMappingOptions::points_per_keyframe.
@@ -275,10 +282,11 @@ void SelectVisualTerm(const GlobalMappingOptions& options, GlobalMapInput* input
                                                options.points_per_keyframe);
   result->selected_observations = static_cast<int64_t>(input->observations.size());
   if (options.points_per_keyframe > 0) {
-    spdlog::info("visual term: {} of {} map points ({} of {} observations), at least {} per "
-                 "keyframe",
-                 result->selected_points, result->input_points, result->selected_observations,
-                 result->input_observations, options.points_per_keyframe);
+    spdlog::info(
+        "visual term: {} of {} map points ({} of {} observations), at least {} per "
+        "keyframe",
+        result->selected_points, result->input_points, result->selected_observations,
+        result->input_observations, options.points_per_keyframe);
   }
 }
 
@@ -289,6 +297,7 @@ FixedTerms PrepareFixedTerms(GlobalMapInput* in, const GlobalMappingOptions& opt
   const GlobalMapInput& input = *in;
   FixedTerms t;
   t.directions = direction::SelectDirections(input.keyframes, input.directions);
+  if (options.use_directions && options.use_vertical) t.vp_rays = input.vp_rays;
   result->directions_not_keyframe = t.directions.not_keyframe;
   result->directions_at_infinity = t.directions.at_infinity;
   if (options.use_directions)
@@ -320,9 +329,8 @@ FixedTerms PrepareFixedTerms(GlobalMapInput* in, const GlobalMappingOptions& opt
 // (kRefit) or with one free d_w block per cluster initialised by the re-estimate (kFree); VPs
 // far from their cluster's direction are dropped in both re-estimated forms.
 void EnterDirections(const Trajectory& keyframes, const PinholeCamera& camera,
-                     const direction::DirectionSelection& dirs,
-                     const GlobalMappingOptions& options, DirectionTerm* term,
-                     GlobalMappingResult* result) {
+                     const direction::DirectionSelection& dirs, const GlobalMappingOptions& options,
+                     DirectionTerm* term, GlobalMappingResult* result) {
   using Source = GlobalMappingOptions::DirectionSource;
   term->entered = true;
   if (options.direction_source == Source::kPrior) {
@@ -352,6 +360,47 @@ void EnterDirections(const Trajectory& keyframes, const PinholeCamera& camera,
     term->constraints[i].free_direction = block_of.at(refit.selection.clusters[i]);
 }
 
+// The vertical direction prior, selected at the poses where e_D enters: one free direction
+// block (after the clusters' ones) and a ray-form constraint per inlier keyframe.
+void EnterVertical(const std::vector<direction::VpRay>& rays, const GlobalMappingOptions& options,
+                   DirectionTerm* term, optim::JointProblemOptions* joint,
+                   GlobalMappingResult* result) {
+  if (rays.empty() || result->keyframes.size() == 0) return;
+  const Eigen::Vector3d up =
+      -(result->keyframes.world_from_cam.front().rotation() * Eigen::Vector3d::UnitY());
+  const direction::VerticalSelection v =
+      direction::SelectVertical(result->keyframes, rays, up, options.vertical_max_deg,
+                                options.vertical_outlier_deg, options.min_vertical_sigma_deg);
+  result->vertical_candidates = v.candidates;
+  result->vertical_outliers = v.outliers;
+  if (static_cast<int>(v.rows.size()) < options.refit_min_support) {
+    spdlog::info(
+        "vertical direction prior: {} of {} candidate keyframes kept, fewer than {}: "
+        "not used",
+        v.rows.size(), v.candidates, options.refit_min_support);
+    return;
+  }
+  result->vertical_used = static_cast<int64_t>(v.rows.size());
+  result->vertical_sigma_deg = v.sigma_deg;
+  result->vertical_direction = v.direction;
+  joint->direction_sigma_rad = v.sigma_deg / kDegPerRad;
+  term->vertical_block = static_cast<int>(term->free_directions.size());
+  term->free_directions.push_back(v.direction);
+  for (size_t i = 0; i < v.rows.size(); ++i) {
+    optim::DirectionConstraint c;
+    c.keyframe = v.rows[i];
+    c.ray_form = true;
+    c.ray = v.rays[i];
+    c.free_direction = term->vertical_block;
+    term->constraints.push_back(c);
+  }
+  result->vertical_rho = v.rho;
+  spdlog::info(
+      "vertical direction prior: {} keyframes ({} candidates, {} outliers), sigma "
+      "{:.3f} deg (lag-1 correlation {:.2f}, inflation {:.2f})",
+      v.rows.size(), v.candidates, v.outliers, v.sigma_deg, v.rho, v.inflation);
+}
+
 // sigma of e_D: given, or estimated where e_D enters from the median |e_D| (2D Gaussian: median
 // |e| = sigma sqrt(2 ln 2)). Measured at the warm-started poses, so it also holds what is left
 // of the drift: an upper bound of the VP noise.
@@ -362,11 +411,22 @@ void SetDirectionSigma(const Trajectory& keyframes, const PinholeCamera& camera,
     result->direction_sigma_px = options.direction_sigma_px;
     return;
   }
+  const auto at_least_min = [&](double sigma) {
+    return std::isfinite(sigma) ? std::max(options.min_direction_sigma_px, sigma) : 1.0;
+  };
+  result->direction_sigma_estimated = true;
+  if (options.direction_sigma_per_axis) {
+    constexpr double kMadToSigma = 1.0 / 0.6744897501960817;  // 1D Gaussian
+    const Eigen::Vector2d mad = direction::MedianAbsDirectionError(keyframes, camera, term.priors);
+    result->direction_sigma_px = at_least_min(mad.x() * kMadToSigma);
+    result->direction_sigma_v_px = at_least_min(mad.y() * kMadToSigma);
+    spdlog::debug("e_D sigma estimated: u {:.3f} px, v {:.3f} px", result->direction_sigma_px,
+                  result->direction_sigma_v_px);
+    return;
+  }
   const double sigma =
       direction::MedianDirectionError(keyframes, camera, term.priors) / std::sqrt(2.0 * M_LN2);
-  result->direction_sigma_px =
-      std::isfinite(sigma) ? std::max(options.min_direction_sigma_px, sigma) : 1.0;
-  result->direction_sigma_estimated = true;
+  result->direction_sigma_px = at_least_min(sigma);
   spdlog::debug("e_D sigma estimated: {:.3f} px", result->direction_sigma_px);
 }
 
@@ -383,6 +443,8 @@ void SetDirectionTerm(int round, const FixedTerms& terms, const PinholeCamera& c
     EnterDirections(result->keyframes, camera, terms.directions, options, term, result);
     SetDirectionSigma(result->keyframes, camera, *term, options, result);
     joint->direction_sigma_px = result->direction_sigma_px;
+    joint->direction_sigma_v_px = result->direction_sigma_v_px;
+    EnterVertical(terms.vp_rays, options, term, joint, result);
   }
   problem->directions = term->constraints;
   problem->free_directions = term->free_directions;
@@ -436,9 +498,9 @@ std::optional<optim::ResidualStats> DirectionCostBefore(int round, const FixedTe
   only.poses = problem.poses;
   only.fixed = problem.fixed;
   only.directions = ToDirectionConstraints(terms.directions.priors);
-  const optim::JointWeights w =
-      optim::ResolveWeights(joint, static_cast<int64_t>(problem.Observations().size()),
-                            optim::CountImls(problem), static_cast<int64_t>(only.directions.size()));
+  const optim::JointWeights w = optim::ResolveWeights(
+      joint, static_cast<int64_t>(problem.Observations().size()), optim::CountImls(problem),
+      static_cast<int64_t>(only.directions.size()));
   optim::JointProblemOptions o = joint;
   o.alpha = w.alpha;
   o.beta = w.beta;
@@ -468,6 +530,11 @@ void AcceptRound(DirectionTerm* direction, optim::JointProblemInput* problem,
   if (!direction->free_directions.empty()) {
     direction->free_directions = result->solve.free_directions;
     result->free_directions = direction->free_directions;
+    if (direction->vertical_block >= 0) {
+      result->vertical_direction =
+          direction->free_directions[static_cast<size_t>(direction->vertical_block)];
+      result->free_directions.pop_back();  // the vertical block is the last one
+    }
   }
 }
 
@@ -507,9 +574,10 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
       }
     }
     if (!result.solve.usable) {
-      spdlog::warn("global optimisation round {} failed ({}); keyframes keep the poses of the "
-                   "previous round",
-                   round, result.solve.termination);
+      spdlog::warn(
+          "global optimisation round {} failed ({}); keyframes keep the poses of the "
+          "previous round",
+          round, result.solve.termination);
       break;
     }
     AcceptRound(&direction, &problem, &result);
@@ -551,50 +619,63 @@ nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
 
 nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMappingOptions& o) {
   const auto& s = r.solve;
-  return {{"before", BreakdownOf(s.before)},
-          {"after", BreakdownOf(s.after)},
-          {"weights",
-           {{"alpha", s.weights.alpha}, {"beta", s.weights.beta}, {"gamma", s.weights.gamma}}},
-          {"weights_from_rule", {{"beta", o.joint.beta <= 0}, {"gamma", o.joint.gamma <= 0}}},
-          {"imls", {{"saved", r.saved_imls}, {"fresh", r.fresh_imls}, {"blocks", s.imls_blocks}}},
-          {"visual",
-           {{"gate_chi2", o.joint.visual_gate_chi2},
-            {"behind_camera", s.dropped_observations},
-            {"gated_observations", s.gated_observations},
-            {"gated_points", s.gated_points},
-            {"max_point_sigma_ratio", o.joint.max_point_sigma_ratio},
-            {"weak_points_held", s.weak_points},
-            {"drop_weak_points", o.joint.drop_weak_points},
-            {"points_per_keyframe", o.points_per_keyframe},
-            {"input_points", r.input_points},
-            {"selected_points", r.selected_points},
-            {"input_observations", r.input_observations},
-            {"selected_observations", r.selected_observations}}},
-          {"directions",
-           {{"used", r.directions_used},
-            {"not_keyframe", r.directions_not_keyframe},
-            {"at_infinity", r.directions_at_infinity},
-            {"enabled", o.use_directions},
-            {"source", ToString(o.direction_source)},
-            {"refit_outlier_deg", o.refit_outlier_deg},
-            {"sigma_px", r.direction_sigma_px},
-            {"sigma_estimated", r.direction_sigma_estimated},
-            {"outliers", r.directions_outliers},
-            {"small_cluster", r.directions_small_cluster},
-            {"change_deg", ChangeJson(r.direction_change_deg)},
-            {"free", FreeJson(r)}}},
-          {"solver",
-           {{"usable", s.usable},
-            {"iterations", r.total_iterations},
-            {"rounds", r.rounds},
-            {"last_round_iterations", s.iterations},
-            {"time_s", s.time_s},
-            {"termination", s.termination},
-            {"linear_solver", s.linear_solver},
-            {"threads", o.solve.threads},
-            {"max_iterations", o.solve.max_iterations}}},
-          {"traversal_time_s", r.traversal_time_s},
-          {"total_time_s", r.total_time_s}};
+  return {
+      {"before", BreakdownOf(s.before)},
+      {"after", BreakdownOf(s.after)},
+      {"weights",
+       {{"alpha", s.weights.alpha}, {"beta", s.weights.beta}, {"gamma", s.weights.gamma}}},
+      {"weights_from_rule", {{"beta", o.joint.beta <= 0}, {"gamma", o.joint.gamma <= 0}}},
+      {"imls", {{"saved", r.saved_imls}, {"fresh", r.fresh_imls}, {"blocks", s.imls_blocks}}},
+      {"visual",
+       {{"gate_chi2", o.joint.visual_gate_chi2},
+        {"behind_camera", s.dropped_observations},
+        {"gated_observations", s.gated_observations},
+        {"gated_points", s.gated_points},
+        {"max_point_sigma_ratio", o.joint.max_point_sigma_ratio},
+        {"weak_points_held", s.weak_points},
+        {"drop_weak_points", o.joint.drop_weak_points},
+        {"points_per_keyframe", o.points_per_keyframe},
+        {"input_points", r.input_points},
+        {"selected_points", r.selected_points},
+        {"input_observations", r.input_observations},
+        {"selected_observations", r.selected_observations}}},
+      {"directions",
+       {{"used", r.directions_used},
+        {"not_keyframe", r.directions_not_keyframe},
+        {"at_infinity", r.directions_at_infinity},
+        {"enabled", o.use_directions},
+        {"source", ToString(o.direction_source)},
+        {"refit_outlier_deg", o.refit_outlier_deg},
+        {"sigma_px", r.direction_sigma_px},
+        {"sigma_v_px", r.direction_sigma_v_px > 0 ? r.direction_sigma_v_px : r.direction_sigma_px},
+        {"sigma_estimated", r.direction_sigma_estimated},
+        {"outliers", r.directions_outliers},
+        {"small_cluster", r.directions_small_cluster},
+        {"change_deg", ChangeJson(r.direction_change_deg)},
+        {"free", FreeJson(r)}}},
+      {"vertical",
+       {{"enabled", o.use_directions && o.use_vertical},
+        {"candidates", r.vertical_candidates},
+        {"used", r.vertical_used},
+        {"outliers", r.vertical_outliers},
+        {"sigma_deg", r.vertical_sigma_deg},
+        {"rho", r.vertical_rho},
+        {"direction", r.vertical_used > 0 ? nlohmann::json::array({r.vertical_direction.x(),
+                                                                   r.vertical_direction.y(),
+                                                                   r.vertical_direction.z()})
+                                          : nlohmann::json(nullptr)}}},
+      {"solver",
+       {{"usable", s.usable},
+        {"iterations", r.total_iterations},
+        {"rounds", r.rounds},
+        {"last_round_iterations", s.iterations},
+        {"time_s", s.time_s},
+        {"termination", s.termination},
+        {"linear_solver", s.linear_solver},
+        {"threads", o.solve.threads},
+        {"max_iterations", o.solve.max_iterations}}},
+      {"traversal_time_s", r.traversal_time_s},
+      {"total_time_s", r.total_time_s}};
 }
 
 std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,

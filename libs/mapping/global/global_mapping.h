@@ -38,8 +38,11 @@ struct GlobalMapInput {
   // compact form a caller may pass instead of millions of correspondences. Needs the compressed
   // e_L form (JointProblemOptions::compress_imls, no Huber kernel on e_L).
   std::vector<optim::ImlsPair> saved_imls_pairs;
-  std::vector<lidar::StoredScan> scans;                     // One per keyframe row (may be empty).
+  std::vector<lidar::StoredScan> scans;              // One per keyframe row (may be empty).
   std::vector<direction::VpAssociation> directions;  // Any frames; non-keyframes skipped.
+  // Every VP of the vps artifact as a camera ray (any frames): the candidates of the vertical
+  // direction prior (GlobalMappingOptions::use_vertical). Empty: no vertical prior.
+  std::vector<direction::VpRay> vp_rays;
   void Check() const;
 };
 
@@ -76,21 +79,33 @@ struct GlobalMappingOptions {
   //  - kPrior: the directions artifact (direction_cluster's d_w, i.e. the prior's rotations;
   //    the paper's supplement 1.4);
   //  - kRefit: re-estimated per cluster from the current keyframe rotations (after the warm-start
-  //    rounds) as the robust mean of the back-projected VPs R_wn K^-1 v (direction::RefitDirections; far
-  //    VPs are dropped), then fixed;
+  //    rounds) as the robust mean of the back-projected VPs R_wn K^-1 v
+  //    (direction::RefitDirections; far VPs are dropped), then fixed;
   //  - kFree: as kRefit, but each cluster's d_w is then a free unit-vector block optimised
   //    with the poses (a landmark at infinity), so that the gauge keyframe and the other terms
   //    fix its absolute orientation and e_D only makes the cluster's keyframes agree.
   enum class DirectionSource { kPrior, kRefit, kFree };
   DirectionSource direction_source = DirectionSource::kFree;
   double refit_outlier_deg = 1.0;  // smallest outlier gate (direction::RefitDirections)
-  int refit_min_support = 3;  // clusters with fewer inlier keyframes are left out
+  int refit_min_support = 3;       // clusters with fewer inlier keyframes are left out
   // sigma of e_D in pixels (its whitening, see JointProblemOptions::direction_sigma_px).
   // <= 0: estimated when e_D enters the problem from the median of |v - pi(R_nw d_w)| at the
   // current poses / sqrt(2 ln 2) (2D Gaussian), at least min_direction_sigma_px. The weight
   // rule then balances whitened residuals.
   double direction_sigma_px = 0.0;
   double min_direction_sigma_px = 0.5;
+  // Estimated sigma per image axis: sigma_u and sigma_v from the medians of |u error| and
+  // |v error| / 0.6745 (1D Gaussians), each at least min_direction_sigma_px. On sloped roads the
+  // VP's row also follows the grade ahead, so v scatters more and its part weighs less.
+  bool direction_sigma_per_axis = false;
+  // Vertical direction prior (beyond the paper): with e_D, one free world direction shared by
+  // the vertical VPs of every keyframe (direction::SelectVertical at the poses where e_D enters),
+  // as ray-form e_D residuals whitened by their measured spread (at least min_vertical_sigma_deg)
+  // and weighted by gamma like e_D. It ties roll and pitch along the whole drive.
+  bool use_vertical = true;
+  double vertical_max_deg = 10.0;     // candidates: VPs within this of the world's up
+  double vertical_outlier_deg = 1.0;  // smallest gate of the robust mean
+  double min_vertical_sigma_deg = 0.05;
   // > 0: the visual term uses a subset of the map points that still gives every keyframe at
   // least this many observations, or all of its own (SelectObservations): the cost of a
   // free-map-point solve grows with the observations. 0 = every point.
@@ -112,10 +127,16 @@ struct GlobalMappingResult {
   // each cluster's d_w (degrees) against the directions artifact.
   int64_t directions_outliers = 0, directions_small_cluster = 0;
   std::map<int32_t, double> direction_change_deg;
-  double direction_sigma_px = 0;  // sigma of e_D used (given or estimated)
+  double direction_sigma_px = 0;                 // sigma of e_D used (given or estimated)
+  double direction_sigma_v_px = 0;               // its v part when estimated per axis (0: as above)
   std::vector<Eigen::Vector3d> free_directions;  // kFree: optimised d_w per kept cluster
   std::vector<int32_t> free_direction_clusters;  // cluster id of each free_directions entry
   bool direction_sigma_estimated = false;
+  // The vertical direction prior: keyframes with a candidate, inliers used, outliers, the
+  // measured sigma (deg) and the optimised direction (NaN when not used).
+  int64_t vertical_candidates = 0, vertical_used = 0, vertical_outliers = 0;
+  double vertical_sigma_deg = 0, vertical_rho = 0;
+  Eigen::Vector3d vertical_direction = Eigen::Vector3d::Constant(std::nan(""));
   double traversal_time_s = 0;
   double total_time_s = 0;
   int rounds = 0;

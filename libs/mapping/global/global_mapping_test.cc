@@ -226,6 +226,9 @@ TEST(GlobalMapping, WeightsFollowTheRuleUnlessGiven) {
   const auto syn = MakeSyntheticGlobal(so);
   GlobalMappingOptions o = Quiet();
   o.solve.max_iterations = 1;
+  // The default weighs the whitened e_D as one measurement per residual.
+  EXPECT_DOUBLE_EQ(OptimizeGlobal(syn.input, o).solve.weights.gamma, 1.0);
+  o.joint.gamma = 0;  // the paper's count rule
   const auto r = OptimizeGlobal(syn.input, o);
   const auto expected = optim::ResolveWeights(
       o.joint, r.solve.after.visual.count, r.solve.after.imls.count, r.solve.after.direction.count);

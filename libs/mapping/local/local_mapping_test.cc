@@ -20,6 +20,27 @@ using testing::StreetPatches;
 
 const PinholeCamera kCamera{718.856, 718.856, 607.1928, 185.2157, 1226, 370};
 
+// The motion over one frame period for de-skewing a keyframe's scan: centred (half of f-1 -> f+1)
+// where both neighbours exist, one-sided at the ends, none without a neighbour.
+TEST(LocalMapping, SweepMotionFromTheNeighbouringFrames) {
+  Trajectory t;
+  for (int f = 0; f < 4; ++f)
+    t.Append(f,
+             Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.02 * f * f, Eigen::Vector3d::UnitY())),
+                     Eigen::Vector3d(0, 0, 1.0 * f * f)));
+  const auto between = [&](int a, int b) {
+    return t.world_from_cam[a].Inverse() * t.world_from_cam[b];
+  };
+  const auto centred = SweepMotion(t, 2);
+  ASSERT_TRUE(centred.has_value());
+  const Vector6d expected = 0.5 * LogSE3(between(1, 3));
+  EXPECT_LT((LogSE3(*centred) - expected).norm(), 1e-12);
+  ASSERT_TRUE(SweepMotion(t, 0).has_value());
+  EXPECT_LT((LogSE3(*SweepMotion(t, 0)) - LogSE3(between(0, 1))).norm(), 1e-12);
+  EXPECT_LT((LogSE3(*SweepMotion(t, 3)) - LogSE3(between(2, 3))).norm(), 1e-12);
+  EXPECT_FALSE(SweepMotion(t, 10).has_value());
+}
+
 TEST(LocalMapping, StartKeyframeIsFirstWithinNFrames) {
   const std::vector<int64_t> frames{0, 3, 5, 9, 12, 20};
   EXPECT_EQ(StartKeyframe(frames, 0, 10, 1), 0u);  // Nothing before the first keyframe.

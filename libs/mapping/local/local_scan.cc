@@ -25,13 +25,28 @@ void ScanOptions::Check() const {
 }
 
 KeyframeScan PrepareKeyframeScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
-                                 const ScanOptions& options, int samples_per_list, int threads) {
-  const lidar::PreprocessedScan pre =
+                                 const ScanOptions& options, int samples_per_list, int threads,
+                                 const std::optional<Rigid3d>& sweep_motion) {
+  lidar::PreprocessedScan pre =
       lidar::PreprocessScan(velo_scan, cam0_from_velo, options.preprocess, threads);
+  if (sweep_motion) lidar::DeskewScan(*sweep_motion, &pre);
   const lidar::ScanSurface surface = lidar::ComputeSurface(pre.points, options.surface, threads);
   KeyframeScan scan = FromSurface(surface, samples_per_list, options.stored_voxel);
   scan.raw_points = static_cast<int64_t>(velo_scan.points.size());
   return scan;
+}
+
+std::optional<Rigid3d> SweepMotion(const Trajectory& trajectory, int64_t frame) {
+  const auto prev = trajectory.IndexOf(frame - 1);
+  const auto cur = trajectory.IndexOf(frame);
+  const auto next = trajectory.IndexOf(frame + 1);
+  const auto between = [&](size_t a, size_t b) {
+    return trajectory.world_from_cam[a].Inverse() * trajectory.world_from_cam[b];
+  };
+  if (prev && next) return ExpSE3(0.5 * LogSE3(between(*prev, *next)));
+  if (prev && cur) return between(*prev, *cur);
+  if (cur && next) return between(*cur, *next);
+  return std::nullopt;
 }
 
 KeyframeScan KeyframeScanFromSurface(const std::vector<Eigen::Vector3d>& points,

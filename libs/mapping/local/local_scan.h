@@ -7,10 +7,12 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "geometry/point_cloud.h"
 #include "geometry/rigid3.h"
+#include "geometry/trajectory.h"
 #include "lidar/association.h"
 #include "lidar/imls.h"
 #include "lidar/preprocess.h"
@@ -38,9 +40,16 @@ struct KeyframeScan {
 };
 
 // Preprocessing (supplement 1.1), normals and sampling lists (IMLS-SLAM Sec. V) of a velodyne
-// scan, for samples_per_list points per list.
+// scan, for samples_per_list points per list. With `sweep_motion` (the motion over one scan
+// period, prev_from_cur in cam0) the points are de-skewed first (lidar::DeskewScan).
 KeyframeScan PrepareKeyframeScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
-                                 const ScanOptions& options, int samples_per_list, int threads);
+                                 const ScanOptions& options, int samples_per_list, int threads,
+                                 const std::optional<Rigid3d>& sweep_motion = std::nullopt);
+
+// The motion over one frame period at `frame` from a trajectory (constant velocity, centred:
+// half the motion from frame - 1 to frame + 1, or the one-sided motion at the ends); nullopt
+// when the trajectory has neither neighbour.
+std::optional<Rigid3d> SweepMotion(const Trajectory& trajectory, int64_t frame);
 
 // Builds a KeyframeScan from points that already have normals (synthetic scans, tests): the
 // planarity is taken as 1 and the sampling lists are computed as for a real scan (whole lists).
