@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/check.h"
+#include "core/statistics.h"
 
 namespace jvl::optim {
 
@@ -41,7 +42,8 @@ Rigid3d KeyframeCorrection(const Rigid3d& prior_world_from_cam,
 }
 
 Trajectory InterpolateFullRate(const Trajectory& prior,
-                               const std::map<int64_t, Rigid3d>& optimized_keyframes) {
+                               const std::map<int64_t, Rigid3d>& optimized_keyframes,
+                               double step_factor, int64_t* bridged) {
   prior.Check("prior trajectory");
   JVL_CHECK(!optimized_keyframes.empty(), "full-rate interpolation needs at least one keyframe");
   // Keyframes as (row in prior, correction), in frame order (the map is sorted by id).
@@ -56,6 +58,23 @@ Trajectory InterpolateFullRate(const Trajectory& prior,
   auto time = [&](size_t row) {
     return prior.has_timestamps() ? prior.timestamps[row] : static_cast<double>(prior.frames[row]);
   };
+  // Intervals where the prior's motion disagrees with the optimised one (a step inside).
+  std::vector<uint8_t> bridge(rows.size(), 0);  // bridge[k]: interval rows[k-1] .. rows[k]
+  if (step_factor > 0 && rows.size() >= 2) {
+    std::vector<double> d(rows.size(), 0.0);
+    for (size_t k = 1; k < rows.size(); ++k) {
+      const Rigid3d& a = optimized_keyframes.at(prior.frames[rows[k - 1]]);
+      const Rigid3d& b = optimized_keyframes.at(prior.frames[rows[k]]);
+      const Rigid3d mismatch =
+          (a.Inverse() * b).Inverse() *
+          (prior.world_from_cam[rows[k - 1]].Inverse() * prior.world_from_cam[rows[k]]);
+      d[k] = mismatch.translation().norm() / static_cast<double>(rows[k] - rows[k - 1]);
+    }
+    const double threshold = step_factor * Median(std::vector<double>(d.begin() + 1, d.end()));
+    for (size_t k = 1; k < rows.size(); ++k)
+      bridge[k] = rows[k] - rows[k - 1] >= 2 && d[k] > threshold ? 1 : 0;
+  }
+  if (bridged != nullptr) *bridged = std::count(bridge.begin(), bridge.end(), 1);
   Trajectory out = prior;
   size_t k = 0;  // first keyframe with rows[k] >= row
   for (size_t row = 0; row < prior.size(); ++row) {
@@ -71,6 +90,11 @@ Trajectory InterpolateFullRate(const Trajectory& prior,
       const double t0 = time(rows[k - 1]);
       const double t1 = time(rows[k]);
       const double s = t1 > t0 ? std::clamp((time(row) - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
+      if (bridge[k]) {
+        out.world_from_cam[row] = Interpolate(optimized_keyframes.at(prior.frames[rows[k - 1]]),
+                                              optimized_keyframes.at(prior.frames[rows[k]]), s);
+        continue;
+      }
       correction = Interpolate(corrections[k - 1], corrections[k], s);
     }
     out.world_from_cam[row] = correction * prior.world_from_cam[row];

@@ -38,7 +38,16 @@ Rigid3d KeyframeCorrection(const Rigid3d& prior_world_from_cam,
 // with the geodesic SE(3) Interpolate and s the time fraction (timestamps if the prior has them,
 // else frame indices). Frames before the first / after the last keyframe take its correction;
 // keyframes get their optimised pose exactly. Every keyframe must be a frame of `prior`.
+//
+// A registration step of the prior between two keyframes would survive that interpolation
+// (it keeps the prior's motion relative to the keyframes). So each interval between
+// consecutive keyframes a < b is compared: d = |translation of (O_a^-1 O_b)^-1 (P_a^-1 P_b)| /
+// (b - a) frames (O optimised, P prior). Where d exceeds step_factor x the median d of all
+// intervals and the interval has frames between its keyframes, those frames get the geodesic
+// SE(3) interpolation of the two optimised poses instead (constant twist between them).
+// step_factor <= 0 turns this off; `bridged` (optional) receives the number of such intervals.
 Trajectory InterpolateFullRate(const Trajectory& prior,
-                               const std::map<int64_t, Rigid3d>& optimized_keyframes);
+                               const std::map<int64_t, Rigid3d>& optimized_keyframes,
+                               double step_factor = 5.0, int64_t* bridged = nullptr);
 
 }  // namespace jvl::optim

@@ -106,7 +106,15 @@ int main(int argc, char** argv) {
       kf[result.keyframes.frames[i]] = result.keyframes.world_from_cam[i];
     io::GlobalData out;
     out.keyframes = result.keyframes;
-    out.trajectory = optim::InterpolateFullRate(prior, kf);
+    int64_t bridged = 0;
+    out.trajectory = optim::InterpolateFullRate(prior, kf, 5.0, &bridged);
+    if (bridged > 0) {
+      spdlog::info(
+          "full-rate trajectory: {} keyframe interval(s) where the prior's motion "
+          "disagrees with the optimised keyframes (a step inside) take the optimised "
+          "poses' geodesic interpolation",
+          bridged);
+    }
     out.prior = prior;
     out.stats = mapping::GlobalStatsJson(result, o);
     io::WriteGlobalArtifact(output, out, tool.MakeProvenance());
