@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Batch pipelines without running a stage: job-list generation, the per-task make command, the
-batch makefile, the Slurm submission (dry run) and the collect step on committed metrics.
+batch makefile, the Slurm submission (dry run), the collect step on committed metrics and the
+gains table on a hand-made run.
 
     python3 tests/pipelines/pipelines_test.py      (from the repository root; CTest does this)
 """
+import json
 import os
 import shutil
 import subprocess
@@ -16,6 +18,7 @@ DATA = os.path.join(ROOT, "tests", "pipelines", "data")
 SPEC = os.path.join(DATA, "small.spec")
 JOBS_PY = os.path.join(ROOT, "pipelines", "jobs.py")
 COLLECT_PY = os.path.join(ROOT, "pipelines", "collect.py")
+GAINS_PY = os.path.join(ROOT, "pipelines", "gains_table.py")
 
 
 def run(args, **kwargs):
@@ -183,6 +186,69 @@ class Collect(unittest.TestCase):
         out = run([sys.executable, COLLECT_PY, SPEC, DATA, "--cell", "r_rel/apex"])
         self.assertEqual(out.returncode, 2)
         self.assertIn("unknown figure 'apex'", out.stderr)
+
+
+def kitti_line(x, z):
+    return f"1 0 0 {x} 0 1 0 0 0 0 1 {z}\n"
+
+
+class GainsTable(unittest.TestCase):
+    """pipelines/gains_table.py on a hand-made run: ratios, steps of the prior, survival."""
+
+    def setUp(self):
+        self.run_dir = tempfile.mkdtemp()
+        data = os.path.join(self.run_dir, "data", "d1")
+        os.makedirs(os.path.join(data, "sequences", "00"))
+        os.makedirs(os.path.join(data, "poses"))
+        base = os.path.join(self.run_dir, "d1", "base")
+        common = os.path.join(self.run_dir, "d1", "common")
+        os.makedirs(base)
+        os.makedirs(common)
+        n = 21
+        gt = [(0.0, 1.0 * i) for i in range(n)]
+        # The prior drifts 1 mm per frame sideways and jumps 0.2 m between frames 10 and 11; the
+        # result without keeps half the jump, the one with removes it.
+        prior = [(0.001 * i + (0.2 if i > 10 else 0.0), 1.0 * i) for i in range(n)]
+        without = [(0.1 if i > 10 else 0.0, 1.0 * i) for i in range(n)]
+        with_ = [(0.0, 1.0 * i) for i in range(n)]
+        for path, poses in ((os.path.join(data, "poses", "00.txt"), gt),
+                            (os.path.join(common, "odom.txt"), prior),
+                            (os.path.join(base, "without_directions.txt"), without),
+                            (os.path.join(base, "with_directions.txt"), with_)):
+            with open(path, "w") as f:
+                f.writelines(kitti_line(x, z) for x, z in poses)
+
+        def estimate(label, ape):
+            return {"label": label,
+                    "ape": {"translation_m": {"rmse": ape}, "rotation_deg": {"rmse": ape / 10}},
+                    "kitti": {"t_rel_percent": None, "r_rel_deg_per_100m": None}}
+        metrics = {"options": {"alignment": "se3"},
+                   "estimates": [estimate("prior", 1.0), estimate("w.o. direction priors", 0.3),
+                                 estimate("w. direction priors", 0.15)]}
+        with open(os.path.join(base, "metrics.json"), "w") as f:
+            json.dump(metrics, f)
+        with open(os.path.join(self.run_dir, "gains.spec"), "w") as f:
+            f.write(f"sequence d1 {data}/sequences/00 ODOM_N=1 ALIGN=se3\n")
+            f.write(f"sequence missing {data}/sequences/00\n")
+
+    def tearDown(self):
+        shutil.rmtree(self.run_dir)
+
+    def test_ratios_steps_and_survival(self):
+        out = run([sys.executable, GAINS_PY, self.run_dir])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        rows = json.loads(read(os.path.join(self.run_dir, "gains.json")))
+        d1 = rows[0]
+        self.assertAlmostEqual(d1["ratio_without_prior"], 0.3)
+        self.assertAlmostEqual(d1["ratio_with_without"], 0.5)
+        self.assertEqual(d1["prior_steps"], 1)  # only the jump exceeds 5x the 1 mm median
+        self.assertEqual(d1["without"]["surviving_steps"], 1)
+        self.assertEqual(d1["with"]["surviving_steps"], 0)
+        self.assertEqual(d1["worst_step"]["frame"], 10)
+        self.assertAlmostEqual(d1["worst_step"]["prior_m"], 0.201, places=6)
+        self.assertAlmostEqual(d1["worst_step"]["without_m"], 0.1, places=6)
+        self.assertTrue(rows[1]["missing"])
+        self.assertIn("| d1 | 21 | 0.02 |", read(os.path.join(self.run_dir, "gains.md")))
 
 
 if __name__ == "__main__":
