@@ -33,6 +33,45 @@ DirectionSelection SelectDirections(const Trajectory& keyframes,
   return out;
 }
 
+namespace {
+
+// Robust mean of unit directions: the mean of those within max(outlier_deg, 3 sigma) of it, sigma
+// from the median angle to the current mean (2D Gaussian: median = 1.1774 sigma), iterated to a
+// fixed point from the plain mean. Returns the indices kept (increasing; empty if none) and the
+// mean in *mean.
+std::vector<size_t> RobustMeanDirection(const std::vector<Eigen::Vector3d>& directions,
+                                        double outlier_deg, Eigen::Vector3d* mean) {
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& x : directions) d += x;
+  d.normalize();
+  std::vector<size_t> kept(directions.size());
+  for (size_t i = 0; i < kept.size(); ++i) kept[i] = i;
+  for (int it = 0; it < 20; ++it) {
+    std::vector<double> angles;
+    for (size_t i : kept) angles.push_back(AngleDeg(directions[i], d));
+    const double gate = std::max(outlier_deg, 3.0 * UpperMedian(std::move(angles)) / 1.1774);
+    std::vector<size_t> next;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < directions.size(); ++i)
+      if (AngleDeg(directions[i], d) <= gate) {
+        next.push_back(i);
+        sum += directions[i];
+      }
+    if (next.empty()) {
+      kept.clear();
+      break;
+    }
+    const bool stable = next == kept;
+    kept = std::move(next);
+    d = sum.normalized();
+    if (stable) break;
+  }
+  *mean = d;
+  return kept;
+}
+
+}  // namespace
+
 DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera& camera,
                                const DirectionSelection& selection, double outlier_deg,
                                int min_support) {
@@ -56,32 +95,11 @@ DirectionRefit RefitDirections(const Trajectory& keyframes, const PinholeCamera&
   out.selection.not_keyframe = selection.not_keyframe;
   out.selection.at_infinity = selection.at_infinity;
   for (const auto& [cluster, idx] : members) {
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    for (size_t i : idx) d += rays[i];
-    d.normalize();
-    // Robust mean: gate = max(outlier_deg, 3 sigma) with sigma from the median angle to the
-    // current mean (2D Gaussian: median = 1.1774 sigma); iterate to a fixed point.
-    std::vector<size_t> kept = idx;
-    for (int it = 0; it < 20; ++it) {
-      std::vector<double> angles;
-      for (size_t i : kept) angles.push_back(AngleDeg(rays[i], d));
-      const double gate = std::max(outlier_deg, 3.0 * UpperMedian(std::move(angles)) / 1.1774);
-      std::vector<size_t> next;
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      for (size_t i : idx)
-        if (AngleDeg(rays[i], d) <= gate) {
-          next.push_back(i);
-          sum += rays[i];
-        }
-      if (next.empty()) {
-        kept.clear();
-        break;
-      }
-      const bool stable = next == kept;
-      kept = std::move(next);
-      d = sum.normalized();
-      if (stable) break;
-    }
+    std::vector<Eigen::Vector3d> members_rays;
+    for (size_t i : idx) members_rays.push_back(rays[i]);
+    Eigen::Vector3d d;
+    std::vector<size_t> kept;
+    for (size_t k : RobustMeanDirection(members_rays, outlier_deg, &d)) kept.push_back(idx[k]);
     out.outliers += static_cast<int64_t>(idx.size() - kept.size());
     if (static_cast<int>(kept.size()) < min_support) {
       out.small_cluster_vps += static_cast<int64_t>(kept.size());
@@ -161,34 +179,15 @@ VerticalSelection SelectVertical(const Trajectory& keyframes, const std::vector<
   VerticalSelection out;
   out.candidates = static_cast<int64_t>(best.size());
   if (best.empty()) return out;
-  Eigen::Vector3d d = Eigen::Vector3d::Zero();
-  for (const auto& [row, rw] : best) d += rw.second;
-  d.normalize();
-  std::vector<size_t> kept;
-  double median_deg = 0;
-  for (int it = 0; it < 20; ++it) {
-    std::vector<double> angles;
-    for (const auto& [row, rw] : best)
-      if (kept.empty() || std::find(kept.begin(), kept.end(), row) != kept.end())
-        angles.push_back(AngleDeg(rw.second, d));
-    median_deg = UpperMedian(std::move(angles));
-    const double gate = std::max(outlier_deg, 3.0 * median_deg / 1.1774);
-    std::vector<size_t> next;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const auto& [row, rw] : best)
-      if (AngleDeg(rw.second, d) <= gate) {
-        next.push_back(row);
-        sum += rw.second;
-      }
-    if (next.empty()) {
-      kept.clear();
-      break;
-    }
-    const bool stable = next == kept;
-    kept = std::move(next);
-    d = sum.normalized();
-    if (stable) break;
+  std::vector<size_t> rows;
+  std::vector<Eigen::Vector3d> world;
+  for (const auto& [row, rw] : best) {
+    rows.push_back(row);
+    world.push_back(rw.second);
   }
+  Eigen::Vector3d d;
+  std::vector<size_t> kept;
+  for (size_t k : RobustMeanDirection(world, outlier_deg, &d)) kept.push_back(rows[k]);
   out.outliers = out.candidates - static_cast<int64_t>(kept.size());
   if (kept.empty()) return out;
   std::vector<double> angles;
