@@ -198,14 +198,9 @@ VerticalSelection SelectVertical(const Trajectory& keyframes, const std::vector<
   }
   out.direction = d;
   // Errors in the tangent plane of d, in keyframe order (kept is sorted by row).
-  const Eigen::Vector3d helper =
-      std::abs(d.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d b1 = d.cross(helper).normalized(), b2 = d.cross(b1);
+  const Eigen::Matrix<double, 3, 2> tangent = TangentBasis(d);
   std::vector<Eigen::Vector2d> e;
-  for (const size_t row : kept) {
-    const Eigen::Vector3d& w = best.at(row).second;
-    e.emplace_back(w.dot(b1), w.dot(b2));
-  }
+  for (const size_t row : kept) e.push_back(tangent.transpose() * best.at(row).second);
   if (e.size() >= 3) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero(), var = Eigen::Vector2d::Zero(),
                     diff = Eigen::Vector2d::Zero();

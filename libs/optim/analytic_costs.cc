@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include "geometry/angles.h"
 #include "optim/cost_functions.h"
 
 namespace jvl::optim {
@@ -152,13 +153,7 @@ bool DirectionProjectionFreeCost::Evaluate(double const* const* parameters, doub
 
 DirectionAngleFreeCost::DirectionAngleFreeCost(const Eigen::Vector3d& ray_cam,
                                                double sqrt_information)
-    : ray_(ray_cam.normalized()), sqrt_information_(sqrt_information) {
-  // Any unit vector not parallel to the ray gives the first tangent axis.
-  const Eigen::Vector3d helper =
-      std::abs(ray_.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  basis_.col(0) = ray_.cross(helper).normalized();
-  basis_.col(1) = ray_.cross(basis_.col(0));
-}
+    : ray_(ray_cam.normalized()), basis_(TangentBasis(ray_)), sqrt_information_(sqrt_information) {}
 
 bool DirectionAngleFreeCost::Evaluate(double const* const* parameters, double* residuals,
                                       double** jacobians) const {

@@ -124,8 +124,8 @@ class DirectionAngleFreeCost : public ceres::SizedCostFunction<2, 7, 3> {
                 double** jacobians) const override;
 
  private:
-  Eigen::Vector3d ray_;
-  Eigen::Matrix<double, 3, 2> basis_;  // orthonormal, normal to ray_
+  const Eigen::Vector3d ray_;
+  const Eigen::Matrix<double, 3, 2> basis_;  // orthonormal, normal to ray_ (TangentBasis)
   const double sqrt_information_;
 };
 
