@@ -147,4 +147,51 @@ class DirectionProjectionCost {
   const double min_z_;
 };
 
+// Relative-motion error e_O(i, j) of two keyframes against a measured motion Z = T_i^-1 T_j (an
+// odometry's motion between their frames; beyond the paper, docs/global_opt.md "Odometry term"):
+//   E = Z^-1 (T_i^-1 T_j),   r = [sqrt_info_rot .* 2 vec(q_E); sqrt_info_trans .* t_E]   [6]
+// with q_E taken with w >= 0 (2 vec(q) is the rotation vector to second order) and a square-root
+// information per axis of the frame j.
+class RelativePoseCost {
+ public:
+  RelativePoseCost(const Eigen::Quaterniond& q_ij, const Eigen::Vector3d& t_ij,
+                   const Eigen::Vector3d& sqrt_info_rot, const Eigen::Vector3d& sqrt_info_trans)
+      : q_ij_inverse_(q_ij.conjugate().normalized()),
+        t_ij_(t_ij),
+        sqrt_info_rot_(sqrt_info_rot),
+        sqrt_info_trans_(sqrt_info_trans) {}
+
+  template <typename T>
+  bool operator()(const T* world_from_i, const T* world_from_j, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wi(world_from_i);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wi(world_from_i + 4);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wj(world_from_j);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wj(world_from_j + 4);
+    const Eigen::Quaternion<T> q_inv = q_ij_inverse_.cast<T>();
+    const Eigen::Quaternion<T> q_i_inv = q_wi.conjugate();
+    const Eigen::Matrix<T, 3, 1> t_rel = q_i_inv * (t_wj - t_wi);
+    Eigen::Quaternion<T> q_err = q_inv * (q_i_inv * q_wj);
+    if (q_err.w() < T(0)) q_err.coeffs() = -q_err.coeffs();
+    const Eigen::Matrix<T, 3, 1> t_err = q_inv * (t_rel - t_ij_.cast<T>());
+    for (int k = 0; k < 3; ++k) {
+      residual[k] = T(2.0 * sqrt_info_rot_(k)) * q_err.vec()(k);
+      residual[3 + k] = T(sqrt_info_trans_(k)) * t_err(k);
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Quaterniond& q_ij, const Eigen::Vector3d& t_ij,
+                                     const Eigen::Vector3d& sqrt_info_rot,
+                                     const Eigen::Vector3d& sqrt_info_trans) {
+    return new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 7, 7>(
+        new RelativePoseCost(q_ij, t_ij, sqrt_info_rot, sqrt_info_trans));
+  }
+
+ private:
+  const Eigen::Quaterniond q_ij_inverse_;
+  const Eigen::Vector3d t_ij_;
+  const Eigen::Vector3d sqrt_info_rot_;
+  const Eigen::Vector3d sqrt_info_trans_;
+};
+
 }  // namespace jvl::optim

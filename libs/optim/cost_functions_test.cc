@@ -181,5 +181,59 @@ TEST(DirectionProjectionCost, FiniteWhenDirectionIsParallelToTheImagePlane) {
   for (double j : jac[0]) EXPECT_TRUE(std::isfinite(j));
 }
 
+TEST(RelativePoseCost, ZeroAtTheMeasuredMotionKnownValuesAndJacobianMatches) {
+  std::mt19937 rng(5);
+  const Rigid3d world_from_i = RandomPose(rng, 0.5, 20.0);
+  const Rigid3d i_from_j = RandomPose(rng, 0.05, 2.0);
+  const Rigid3d world_from_j = world_from_i * i_from_j;
+  std::unique_ptr<ceres::CostFunction> cost(
+      RelativePoseCost::Create(i_from_j.rotation(), i_from_j.translation(),
+                               Eigen::Vector3d::Constant(1.0 / 0.01), Eigen::Vector3d(10, 20, 5)));
+  PoseBlock pose_i = ToPoseBlock(world_from_i);
+  PoseBlock pose_j = ToPoseBlock(world_from_j);
+  for (const double r : Residuals(*cost, {pose_i.data(), pose_j.data()})) EXPECT_NEAR(r, 0.0, 1e-9);
+
+  // j moved 0.05 m along the axis x of the measured j frame: r_t = (0.05 x 10, 0, 0).
+  const Rigid3d moved_j =
+      world_from_j * Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.05, 0, 0));
+  PoseBlock pose_moved = ToPoseBlock(moved_j);
+  std::vector<double> r = Residuals(*cost, {pose_i.data(), pose_moved.data()});
+  EXPECT_NEAR(r[3], 0.5, 1e-9);
+  EXPECT_NEAR(r[4], 0.0, 1e-9);
+  EXPECT_NEAR(r[0], 0.0, 1e-9);
+  // j turned 0.002 rad about its own z: the rotation part is (0, 0, 0.002) / 0.01 to 2nd order.
+  const Rigid3d turned_j =
+      world_from_j * Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.002, Eigen::Vector3d::UnitZ())),
+                             Eigen::Vector3d::Zero());
+  PoseBlock pose_turned = ToPoseBlock(turned_j);
+  r = Residuals(*cost, {pose_i.data(), pose_turned.data()});
+  EXPECT_NEAR(r[2], 0.2, 1e-6);
+  EXPECT_NEAR(r[3], 0.0, 1e-9);
+
+  std::string log;
+  EXPECT_LT(CheckGradient(*cost, {true, true}, {pose_i.data(), pose_moved.data()}, &log), 1e-6)
+      << log;
+}
+
+TEST(RelativePoseCost, InvariantToACommonRigidMotionOfBothPoses) {
+  std::mt19937 rng(6);
+  const Rigid3d world_from_i = RandomPose(rng, 0.5, 20.0);
+  const Rigid3d world_from_j = world_from_i * RandomPose(rng, 0.05, 2.0);
+  const Rigid3d measured = RandomPose(rng, 0.05, 2.0);
+  std::unique_ptr<ceres::CostFunction> cost(
+      RelativePoseCost::Create(measured.rotation(), measured.translation(),
+                               Eigen::Vector3d(100, 50, 200), Eigen::Vector3d(10, 20, 5)));
+  PoseBlock pose_i = ToPoseBlock(world_from_i);
+  PoseBlock pose_j = ToPoseBlock(world_from_j);
+  const std::vector<double> r0 = Residuals(*cost, {pose_i.data(), pose_j.data()});
+  for (int trial = 0; trial < 5; ++trial) {
+    const Rigid3d g = RandomPose(rng, 1.0, 50.0);
+    PoseBlock moved_i = ToPoseBlock(g * world_from_i);
+    PoseBlock moved_j = ToPoseBlock(g * world_from_j);
+    const std::vector<double> r = Residuals(*cost, {moved_i.data(), moved_j.data()});
+    for (size_t k = 0; k < r.size(); ++k) EXPECT_NEAR(r[k], r0[k], 1e-8);
+  }
+}
+
 }  // namespace
 }  // namespace jvl::optim

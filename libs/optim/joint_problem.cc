@@ -80,6 +80,16 @@ void CheckResiduals(const JointProblemInput& input) {
                                                   << d.free_direction << " of "
                                                   << input.free_directions.size());
   }
+  for (const RelativePoseConstraint& r : input.relative_poses) {
+    CheckKeyframe(input, r.i, "relative pose constraint");
+    CheckKeyframe(input, r.j, "relative pose constraint");
+    JVL_CHECK(r.i != r.j, "relative pose constraint with i == j == " << r.i);
+    JVL_CHECK(r.sigma_rad.allFinite() && r.sigma_rad.minCoeff() > 0 && r.sigma_m.allFinite() &&
+                  r.sigma_m.minCoeff() > 0 && Finite(r.i_from_j.translation()) &&
+                  r.i_from_j.rotation().coeffs().allFinite(),
+              "relative pose constraint (" << r.i << ", " << r.j
+                                           << ") has a non-finite motion or a sigma <= 0");
+  }
   for (size_t i = 0; i < input.free_directions.size(); ++i)
     JVL_CHECK(Finite(input.free_directions[i]) && input.free_directions[i].norm() > 1e-9,
               "free direction " << i << " is not finite or zero");
@@ -265,6 +275,7 @@ void JointProblemOptions::Check() const {
   JVL_CHECK(std::isfinite(direction_sigma_v_px) && direction_sigma_v_px >= 0,
             "direction_sigma_v_px must be >= 0 (0: as direction_sigma_px)");
   JVL_CHECK(direction_min_z > 0 && direction_min_z < 1, "direction_min_z must be in (0, 1)");
+  JVL_CHECK(std::isfinite(relative_cauchy), "relative_cauchy must be finite");
   JVL_CHECK(std::isfinite(visual_gate_chi2), "visual_gate_chi2 must be finite");
   JVL_CHECK(std::isfinite(max_point_sigma_ratio), "max_point_sigma_ratio must be finite");
   JVL_CHECK(
@@ -343,6 +354,17 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
   if (!jp.visual_blocks.empty()) visual_loss.release();
   if (!jp.imls_blocks.empty()) imls_loss.release();
   if (!jp.direction_blocks.empty()) direction_loss.release();
+  // e_O: whitened, weight 1, Cauchy kernel (one shared loss; the problem deletes it once).
+  if (!input.relative_poses.empty()) {
+    ceres::LossFunction* relative_loss =
+        options.relative_cauchy > 0 ? new ceres::CauchyLoss(options.relative_cauchy) : nullptr;
+    for (const RelativePoseConstraint& r : input.relative_poses) {
+      jp.relative_blocks.push_back(jp.problem->AddResidualBlock(
+          RelativePoseCost::Create(r.i_from_j.rotation(), r.i_from_j.translation(),
+                                   r.sigma_rad.cwiseInverse(), r.sigma_m.cwiseInverse()),
+          relative_loss, jp.poses.at(r.i).data(), jp.poses.at(r.j).data()));
+    }
+  }
 
   // Gauge: the fixed keyframes, or the first one (six degrees of freedom; LiDAR fixes scale).
   jp.fixed = input.fixed;

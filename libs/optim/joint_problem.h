@@ -68,6 +68,17 @@ struct DirectionConstraint {
   Eigen::Vector3d ray = Eigen::Vector3d::UnitZ();
 };
 
+// A measured relative motion between two keyframes, Z = world_from_i^-1 world_from_j (e_O; beyond
+// the paper: an odometry's motion, docs/global_opt.md "Odometry term"), with its noise.
+struct RelativePoseConstraint {
+  int64_t i = 0;
+  int64_t j = 0;
+  Rigid3d i_from_j;
+  // Noise per axis of the residual (frame j): rotation (radians) and translation (metres).
+  Eigen::Vector3d sigma_rad = Eigen::Vector3d::Constant(1e-3);
+  Eigen::Vector3d sigma_m = Eigen::Vector3d::Constant(1e-2);
+};
+
 struct JointProblemInput {
   PinholeCamera camera;
   std::map<int64_t, Rigid3d> poses;         // keyframe id -> world_from_cam (initial values)
@@ -85,7 +96,8 @@ struct JointProblemInput {
   // same pair. Needs the compressed form (compress_imls, no Huber kernel on e_L).
   std::vector<ImlsPair> imls_pairs;
   std::vector<DirectionConstraint> directions;
-  std::vector<Eigen::Vector3d> free_directions;  // initial values of the free d_w blocks
+  std::vector<Eigen::Vector3d> free_directions;        // initial values of the free d_w blocks
+  std::vector<RelativePoseConstraint> relative_poses;  // e_O (weight 1 on whitened residuals)
 };
 
 struct JointProblemOptions {
@@ -113,6 +125,10 @@ struct JointProblemOptions {
   double imls_huber = 0.0;
   double direction_huber = 0.0;
   double direction_min_z = 0.05;  // clamp of DirectionProjectionCost (see cost_functions.h)
+  // Cauchy kernel of e_O on the whitened 6-vector's norm (<= 0: none): a measured motion that
+  // disagrees with the other terms by many sigmas (an odometry's registration step) loses its
+  // pull instead of dragging the solution.
+  double relative_cauchy = 3.0;
   // Outlier gate on e_V at the initial estimate (whitened squared reprojection error; <= 0: off).
   // Observations above it are left out of the problem, and with free map points so is every
   // point left with fewer than 2 observations (its depth would be unconstrained). ORB-SLAM's
@@ -157,7 +173,7 @@ struct JointProblem {
   std::vector<std::array<double, 3>> map_points;
   std::vector<std::array<double, 3>> free_directions;
   std::unique_ptr<ceres::Problem> problem;
-  std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks;
+  std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks, relative_blocks;
   std::vector<int64_t> imls_block_counts;  // correspondences in each of imls_blocks
   std::set<int64_t> fixed;                 // effective constant poses (gauge)
   JointWeights weights;
@@ -201,7 +217,7 @@ struct ResidualStats {
 };
 
 struct JointCostBreakdown {
-  ResidualStats visual, imls, direction;
+  ResidualStats visual, imls, direction, relative;
   double total = 0.0;
 };
 

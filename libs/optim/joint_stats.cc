@@ -107,12 +107,13 @@ JointCostBreakdown EvaluateJointCost(JointProblem& jp) {
   JointCostBreakdown b;
   int64_t imls_count = 0;
   for (int64_t c : jp.imls_block_counts) imls_count += c;
-  b.visual =
-      Evaluate(*jp.problem, jp.visual_blocks, static_cast<int64_t>(jp.visual_blocks.size()));
+  b.visual = Evaluate(*jp.problem, jp.visual_blocks, static_cast<int64_t>(jp.visual_blocks.size()));
   b.imls = Evaluate(*jp.problem, jp.imls_blocks, imls_count);
-  b.direction = Evaluate(*jp.problem, jp.direction_blocks,
-                         static_cast<int64_t>(jp.direction_blocks.size()));
-  b.total = b.visual.cost + b.imls.cost + b.direction.cost;
+  b.direction =
+      Evaluate(*jp.problem, jp.direction_blocks, static_cast<int64_t>(jp.direction_blocks.size()));
+  b.relative =
+      Evaluate(*jp.problem, jp.relative_blocks, static_cast<int64_t>(jp.relative_blocks.size()));
+  b.total = b.visual.cost + b.imls.cost + b.direction.cost + b.relative.cost;
   return b;
 }
 
@@ -145,8 +146,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   }
   result.linear_solver = ceres::LinearSolverTypeToString(so.linear_solver_type);
   phase.Reset();
-  if (options.evaluate_after || !result.usable)
-    result.after = EvaluateJointCost(jp);
+  if (options.evaluate_after || !result.usable) result.after = EvaluateJointCost(jp);
   spdlog::debug(
       "joint solve: cost by term {:.1f} s before, {:.1f} s after; Ceres preprocessor {:.1f} s, "
       "minimizer {:.1f} s (Jacobians {:.1f} s, residuals {:.1f} s, linear solver {:.1f} s), "

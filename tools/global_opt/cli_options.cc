@@ -45,6 +45,13 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
               "Leave out the vertical direction prior of --vps (ablation)");
   method.Add("--vertical-max-deg", o->vertical_max_deg,
              "Vertical prior: a VP is a candidate within this angle of the world's up (deg)");
+  method.Flag("!--no-odometry", o->use_odometry,
+              "Leave out the odometry term e_O (the paper's energy; ablation)");
+  method.Add("--odometry-gate", o->odometry_gate,
+             "Leave out odometry pairs whose whitened e_O exceeds this at the first round's "
+             "solution (the odometry's steps; <= 0: keep all)");
+  method.Add("--odometry-cauchy", o->joint.relative_cauchy,
+             "Cauchy kernel scale of e_O on its whitened norm (<= 0: none)");
   method.Add("--direction-huber", o->joint.direction_huber,
              "Huber threshold of e_D in sigmas (<= 0: none)");
   method.Add("--visual-gate", o->joint.visual_gate_chi2,

@@ -21,8 +21,8 @@ int main(int argc, char** argv) {
   app::Tool tool("global_opt",
                  "Global joint optimisation: visual reprojection + point-to-IMLS + direction "
                  "projection errors over all keyframes (Eq. 7), full-rate trajectory and map.");
-  std::string local_path, visual_path, directions_path, vps_path, prior_path, output, kitti,
-      map_path;
+  std::string local_path, visual_path, directions_path, vps_path, prior_path, odometry_path, output,
+      kitti, map_path;
   double map_voxel = 0.2;
   bool map_ascii = false;
   mapping::GlobalMappingOptions o;  // the library's defaults are the tool's
@@ -39,6 +39,12 @@ int main(int argc, char** argv) {
   tool.InputFile(cli.add_option(
       "--prior", prior_path,
       "Full-rate prior to correct (.h5 artifact, KITTI, TUM); default: local's prior"));
+  tool.InputFile(cli.add_option(
+      "--odometry", odometry_path,
+      "Odometry of the odometry term e_O: its motion between consecutive keyframes, robustly "
+      "weighted (.h5 artifact, KITTI, TUM; default: the prior). In a re-association pass, "
+      "pass the chain's first prior (lidar_odom) here: its motion is locally smoother than a "
+      "global result's"));
   tool.OutputFile(cli.add_option("-o,--output", output, "global artifact to write")->required());
   tool.OutputFile(
       cli.add_option("--kitti-poses", kitti, "Full-rate trajectory as KITTI poses text"));
@@ -88,9 +94,15 @@ int main(int argc, char** argv) {
         tool.AddInput(prior_path);
       }
       JVL_CHECK(!prior.empty(), "no prior trajectory: pass --prior");
+      Trajectory odometry = prior;
+      if (!odometry_path.empty()) {
+        odometry = io::ReadTrajectory(odometry_path);
+        tool.AddInput(odometry_path);
+      }
       o.joint.octave_scale_factor = visual.scale_factor;
       input = mapping::AssembleGlobalInput(visual, std::move(local),
                                            directions_path.empty() ? nullptr : &directions);
+      if (o.use_odometry) input.odometry = std::move(odometry);
       if (!vps_path.empty() && !flags.no_direction && o.use_vertical) {
         tool.AddInput(vps_path);
         for (const io::VpRecord& v : io::ReadVpsArtifact(vps_path).vps)

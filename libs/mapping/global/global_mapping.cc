@@ -12,6 +12,7 @@
 
 #include "core/check.h"
 #include "core/memory.h"
+#include "core/statistics.h"
 #include "core/threads.h"
 #include "core/timer.h"
 #include "geometry/angles.h"
@@ -42,6 +43,7 @@ void GlobalMapInput::Check() const {
   for (const auto& p : saved_imls_pairs)
     JVL_CHECK(p.n >= 0 && p.n < k && p.c >= 0 && p.c < k,
               "IMLS pair (" << p.n << ", " << p.c << ") out of range");
+  if (!odometry.empty()) odometry.Check("global input odometry");
 }
 
 void ImlsTraversalOptions::Check() const {
@@ -90,6 +92,10 @@ void GlobalMappingOptions::Check() const {
   JVL_CHECK(std::isfinite(direction_sigma_px) && std::isfinite(min_direction_sigma_px) &&
                 min_direction_sigma_px > 0,
             "direction_sigma_px must be finite and min_direction_sigma_px > 0");
+  JVL_CHECK(std::isfinite(odometry_gate), "odometry_gate must be finite");
+  JVL_CHECK(std::isfinite(min_odometry_sigma_m) && min_odometry_sigma_m > 0 &&
+                std::isfinite(min_odometry_sigma_deg) && min_odometry_sigma_deg > 0,
+            "the minimum odometry sigmas must be positive");
 }
 
 int64_t SelectObservations(std::vector<optim::VisualObservation>* observations, size_t num_points,
@@ -272,6 +278,113 @@ struct DirectionTerm {
   std::vector<Eigen::Vector3d> free_directions;  // kFree: current d_w of each kept cluster
   int vertical_block = -1;  // index of the vertical prior's direction in free_directions
 };
+
+// e_O once it has entered the problem (GlobalMappingOptions::use_odometry).
+struct OdometryTerm {
+  bool entered = false;
+  std::vector<optim::RelativePoseConstraint> constraints;  // keyframe rows i, i + 1
+};
+
+// The residual of E = Z^-1 (T_i^-1 T_j) per axis, [2 vec(q_E); t_E] (RelativePoseCost without
+// its whitening), per frame of the interval (divided by sqrt(frames)).
+Eigen::Matrix<double, 6, 1> RelativeError(const optim::RelativePoseConstraint& c,
+                                          const Trajectory& keyframes, int64_t frames) {
+  const Rigid3d e = c.i_from_j.Inverse() *
+                    (keyframes.world_from_cam[c.i].Inverse() * keyframes.world_from_cam[c.j]);
+  Eigen::Quaterniond q = e.rotation();
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  Eigen::Matrix<double, 6, 1> r;
+  r << 2.0 * q.vec(), e.translation();
+  return r / std::sqrt(static_cast<double>(std::max<int64_t>(frames, 1)));
+}
+
+// Squared norm of the whitened residual of `c` at `keyframes`.
+double WhitenedSquaredNorm(const optim::RelativePoseConstraint& c, const Trajectory& keyframes) {
+  const Eigen::Matrix<double, 6, 1> r = RelativeError(c, keyframes, 1);
+  return r.head<3>().cwiseQuotient(c.sigma_rad).squaredNorm() +
+         r.tail<3>().cwiseQuotient(c.sigma_m).squaredNorm();
+}
+
+// The odometry's motion between consecutive keyframes whose frames it holds, with a sigma per
+// axis measured against `keyframes` (the first round's solution): 1.4826 x the median absolute
+// per-frame residual (MAD about zero), at least the minimum; the pairs above the gate are left
+// out.
+void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
+                   const GlobalMappingOptions& options, OdometryTerm* term,
+                   GlobalMappingResult* result) {
+  term->entered = true;
+  if (odometry.empty()) return;
+  std::vector<optim::RelativePoseConstraint> pairs;
+  std::vector<int64_t> frames;
+  for (size_t i = 0; i + 1 < keyframes.size(); ++i) {
+    const auto a = odometry.IndexOf(keyframes.frames[i]);
+    const auto b = odometry.IndexOf(keyframes.frames[i + 1]);
+    if (!a || !b) continue;
+    optim::RelativePoseConstraint c;
+    c.i = static_cast<int64_t>(i);
+    c.j = static_cast<int64_t>(i + 1);
+    c.i_from_j = odometry.world_from_cam[*a].Inverse() * odometry.world_from_cam[*b];
+    pairs.push_back(c);
+    frames.push_back(keyframes.frames[i + 1] - keyframes.frames[i]);
+  }
+  result->odometry_pairs = static_cast<int64_t>(pairs.size());
+  if (pairs.empty()) {
+    spdlog::warn("odometry term: the odometry holds no consecutive keyframe pair; left out");
+    return;
+  }
+  std::vector<std::vector<double>> abs(6);
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    const Eigen::Matrix<double, 6, 1> r = RelativeError(pairs[k], keyframes, frames[k]);
+    for (int a = 0; a < 6; ++a) abs[a].push_back(std::abs(r(a)));
+  }
+  Eigen::Vector3d sigma_rad, sigma_m;
+  for (int a = 0; a < 3; ++a) {
+    sigma_rad(a) = std::max(options.min_odometry_sigma_deg / kDegPerRad, 1.4826 * Median(abs[a]));
+    sigma_m(a) = std::max(options.min_odometry_sigma_m, 1.4826 * Median(abs[3 + a]));
+  }
+  result->odometry_sigma_deg = sigma_rad * kDegPerRad;
+  result->odometry_sigma_m = sigma_m;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    optim::RelativePoseConstraint c = pairs[k];
+    const double s = std::sqrt(static_cast<double>(frames[k]));
+    c.sigma_rad = sigma_rad * s;
+    c.sigma_m = sigma_m * s;
+    if (options.odometry_gate > 0 &&
+        WhitenedSquaredNorm(c, keyframes) > options.odometry_gate * options.odometry_gate) {
+      ++result->odometry_gated;
+      continue;
+    }
+    term->constraints.push_back(c);
+  }
+  spdlog::info(
+      "odometry term: {} keyframe pairs ({} left out above the gate), sigma per frame "
+      "({:.4f}, {:.4f}, {:.4f}) m, ({:.4f}, {:.4f}, {:.4f}) deg (camera x, y, z; measured against "
+      "the first round)",
+      term->constraints.size(), result->odometry_gated, sigma_m.x(), sigma_m.y(), sigma_m.z(),
+      result->odometry_sigma_deg.x(), result->odometry_sigma_deg.y(),
+      result->odometry_sigma_deg.z());
+}
+
+// e_O of this round: from the second round on (its sigmas need a solution without it; a single
+// round, without a fresh traversal, leaves it out).
+void SetOdometryTerm(int round, const GlobalMapInput& input, const GlobalMappingOptions& options,
+                     OdometryTerm* term, optim::JointProblemInput* problem,
+                     GlobalMappingResult* result) {
+  problem->relative_poses.clear();
+  if (!options.use_odometry || input.odometry.empty() || round < 1) return;
+  if (!term->entered) EnterOdometry(result->keyframes, input.odometry, options, term, result);
+  problem->relative_poses = term->constraints;
+}
+
+// Pairs of the final solution whose whitened e_O is above the kernel scale.
+int64_t CountOdometryOutliers(const OdometryTerm& term, const Trajectory& keyframes,
+                              double cauchy) {
+  if (cauchy <= 0) return 0;
+  int64_t n = 0;
+  for (const auto& c : term.constraints)
+    if (WhitenedSquaredNorm(c, keyframes) > cauchy * cauchy) ++n;
+  return n;
+}
 
 // e_V (Eq. 5): the subset of the map points of GlobalMappingOptions::points_per_keyframe.
 void SelectVisualTerm(const GlobalMappingOptions& options, GlobalMapInput* input,
@@ -555,12 +668,16 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   problem.shared_observations = &input.observations;
   optim::JointProblemOptions joint = options.joint;  // direction sigma set once e_D enters
   DirectionTerm direction;
+  OdometryTerm odometry;
+  if (options.use_odometry && !input.odometry.empty() && terms.rounds < 2)
+    spdlog::info("odometry term left out: it needs a second round (a fresh traversal)");
   optim::JointCostBreakdown before;  // Eq. (7) at the input poses
   for (int round = 0; round < terms.rounds; ++round) {
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
     SetDirectionTerm(round, terms, input.camera, options, &direction, &joint, &problem, &result);
     SetImlsTerm(round, terms, options, &input, &problem, &result);
+    SetOdometryTerm(round, input, options, &odometry, &problem, &result);
     const auto direction_before = DirectionCostBefore(round, terms, problem, joint, options);
     result.solve = SolveRound(round, terms.rounds, problem, joint, options.solve);
     ReleaseFreeHeapMemory();  // the round's Ceres problem is gone (core/memory.h)
@@ -583,6 +700,11 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
     AcceptRound(&direction, &problem, &result);
   }
   result.solve.before = before;  // report the costs at the input poses
+  result.odometry_outliers =
+      CountOdometryOutliers(odometry, result.keyframes, options.joint.relative_cauchy);
+  if (!odometry.constraints.empty())
+    spdlog::info("odometry term: {} of {} keyframe pairs above the kernel scale (down-weighted)",
+                 result.odometry_outliers, odometry.constraints.size());
   result.total_time_s = total.ElapsedSeconds();
   return result;
 }
@@ -612,6 +734,7 @@ nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
   return {{"visual", StatsOf(b.visual)},
           {"imls", StatsOf(b.imls)},
           {"direction", StatsOf(b.direction)},
+          {"odometry", StatsOf(b.relative)},
           {"total", b.total}};
 }
 
@@ -664,6 +787,16 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
                                                                    r.vertical_direction.y(),
                                                                    r.vertical_direction.z()})
                                           : nlohmann::json(nullptr)}}},
+      {"odometry",
+       {{"enabled", o.use_odometry},
+        {"pairs", r.odometry_pairs},
+        {"gate", o.odometry_gate},
+        {"gated", r.odometry_gated},
+        {"outliers", r.odometry_outliers},
+        {"sigma_m", {r.odometry_sigma_m.x(), r.odometry_sigma_m.y(), r.odometry_sigma_m.z()}},
+        {"sigma_deg",
+         {r.odometry_sigma_deg.x(), r.odometry_sigma_deg.y(), r.odometry_sigma_deg.z()}},
+        {"cauchy", o.joint.relative_cauchy}}},
       {"solver",
        {{"usable", s.usable},
         {"iterations", r.total_iterations},

@@ -43,6 +43,9 @@ struct GlobalMapInput {
   // Every VP of the vps artifact as a camera ray (any frames): the candidates of the vertical
   // direction prior (GlobalMappingOptions::use_vertical). Empty: no vertical prior.
   std::vector<direction::VpRay> vp_rays;
+  // The odometry of the odometry term e_O (GlobalMappingOptions::use_odometry): any trajectory
+  // holding the keyframes' frames (e.g. the lidar_odom prior). Empty: no e_O.
+  Trajectory odometry;
   void Check() const;
 };
 
@@ -106,6 +109,19 @@ struct GlobalMappingOptions {
   double vertical_max_deg = 10.0;     // candidates: VPs within this of the world's up
   double vertical_outlier_deg = 1.0;  // smallest gate of the robust mean
   double min_vertical_sigma_deg = 0.05;
+  // Odometry term e_O (beyond the paper, docs/global_opt.md "Odometry term"): from the round
+  // after the first on, the motion of GlobalMapInput::odometry between consecutive keyframes
+  // (optim::RelativePoseCost), whitened by its noise per axis as measured against the first
+  // round's solution (1.4826 x the median absolute residual per frame of the interval; an
+  // interval of n frames: sigma x sqrt(n); each at least the minimum below) and robust
+  // (JointProblemOptions::relative_cauchy). An odometry is locally smoother than the
+  // other terms where it tracks, and its registration steps fall to the kernel.
+  bool use_odometry = true;
+  // Pairs whose whitened 6-vector norm at the first round's solution exceeds this gate are left
+  // out (the odometry's steps; sqrt(chi2(6, 0.99)) = 4.1; <= 0: keep all).
+  double odometry_gate = 4.1;
+  double min_odometry_sigma_m = 0.001;
+  double min_odometry_sigma_deg = 0.01;
   // > 0: the visual term uses a subset of the map points that still gives every keyframe at
   // least this many observations, or all of its own (SelectObservations): the cost of a
   // free-map-point solve grows with the observations. 0 = every point.
@@ -136,6 +152,11 @@ struct GlobalMappingResult {
   // measured sigma (deg) and the optimised direction (NaN when not used).
   int64_t vertical_candidates = 0, vertical_used = 0, vertical_outliers = 0;
   double vertical_sigma_deg = 0, vertical_rho = 0;
+  // The odometry term: keyframe pairs, the measured per-frame sigmas, and the pairs whose
+  // whitened residual ended above the kernel scale (down-weighted: the odometry's steps).
+  int64_t odometry_pairs = 0, odometry_gated = 0, odometry_outliers = 0;
+  Eigen::Vector3d odometry_sigma_m = Eigen::Vector3d::Zero();  // per frame, camera x, y, z
+  Eigen::Vector3d odometry_sigma_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d vertical_direction = Eigen::Vector3d::Constant(std::nan(""));
   double traversal_time_s = 0;
   double total_time_s = 0;

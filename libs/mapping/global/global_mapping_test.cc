@@ -220,6 +220,64 @@ TEST(GlobalMapping, FreeDirectionsBeatAFixedReestimate) {
   EXPECT_LT(free.with.translation_m, 0.5 * fixed.with.translation_m);
 }
 
+// The odometry term: an odometry that tracks the truth with millimetre noise but jumps 0.3 m
+// sideways between two keyframes. Its motion makes the result locally smoother than the other
+// terms alone, and the gate leaves the jump out instead of pulling the result into it.
+TEST(GlobalMapping, OdometryTermSmoothsAndLeavesTheOdometrysStepOut) {
+  SyntheticGlobalOptions so;
+  so.keyframes = 30;
+  so.biased_local = false;
+  so.yaw_drift = 0.1 * M_PI / 180.0;
+  auto syn = MakeSyntheticGlobal(so);
+  ImlsTraversalOptions local;
+  local.scan_map_size = 1;
+  local.association.samples_per_list = 10;
+  syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
+  const int step_keyframe = 15;  // the jump lies between keyframes 15 and 16
+  const int64_t step_frame = syn.input.keyframes.frames[step_keyframe + 1];
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  Trajectory odometry;
+  Rigid3d pose = syn.truth.world_from_cam[0];
+  for (size_t f = 0; f < syn.truth.size(); ++f) {
+    if (f > 0) {
+      Rigid3d motion = syn.truth.world_from_cam[f - 1].Inverse() * syn.truth.world_from_cam[f];
+      Eigen::Vector3d t = motion.translation() + Eigen::Vector3d(noise(rng), noise(rng), 0.0);
+      if (syn.truth.frames[f] == step_frame) t.x() += 0.3;
+      pose = pose * Rigid3d(motion.rotation(), t);
+    }
+    odometry.Append(syn.truth.frames[f], pose);
+  }
+  syn.input.odometry = odometry;
+  GlobalMappingOptions o = Quiet();
+  o.use_directions = false;
+  const GlobalMappingResult with = OptimizeGlobal(syn.input, o);
+  o.use_odometry = false;
+  const GlobalMappingResult without = OptimizeGlobal(syn.input, o);
+  ASSERT_TRUE(with.solve.usable && without.solve.usable);
+  EXPECT_EQ(with.odometry_pairs, so.keyframes - 1);
+  EXPECT_EQ(with.odometry_gated, 1);
+  EXPECT_EQ(without.odometry_pairs, 0);
+  EXPECT_GT(with.solve.after.relative.count, 0);
+  // Error of the motion between consecutive keyframes (m): RMS, and at the jump.
+  const auto motion_error = [&](const GlobalMappingResult& r, size_t i) {
+    const Rigid3d est = r.keyframes.world_from_cam[i].Inverse() * r.keyframes.world_from_cam[i + 1];
+    const Rigid3d truth = syn.truth_keyframes[i].Inverse() * syn.truth_keyframes[i + 1];
+    return (est.translation() - truth.translation()).norm();
+  };
+  const auto rms = [&](const GlobalMappingResult& r) {
+    double sum = 0;
+    for (size_t i = 0; i + 1 < r.keyframes.size(); ++i) sum += std::pow(motion_error(r, i), 2);
+    return std::sqrt(sum / static_cast<double>(r.keyframes.size() - 1));
+  };
+  std::printf(
+      "keyframe motion error RMS: %.4f m with e_O, %.4f m without; at the jump %.4f / %.4f m\n",
+      rms(with), rms(without), motion_error(with, step_keyframe),
+      motion_error(without, step_keyframe));
+  EXPECT_LT(rms(with), 0.8 * rms(without));
+  EXPECT_LT(motion_error(with, step_keyframe), motion_error(without, step_keyframe) + 0.01);
+}
+
 TEST(GlobalMapping, WeightsFollowTheRuleUnlessGiven) {
   SyntheticGlobalOptions so;
   so.keyframes = 6;
