@@ -18,7 +18,8 @@ environment. Relative paths are relative to the repository root, where the tasks
 The job list has one task per line, `PHASE SEQUENCE CONFIG VAR=value ...` (shell quoting):
 `common` (per sequence: the prior and the vanishing points), `config` (the chain from
 direction_cluster to evaluate in the configuration's folder) and `reweight` (global_opt +
-evaluate only, reusing the artifacts of the configuration named by UPSTREAM=). A task runs
+evaluate, and Makefile.example's re-association passes after the first, reusing the pass-1
+artifacts of the configuration named by UPSTREAM=). A task runs
 `make -f Makefile.example` in RUN/SEQUENCE/CONFIG; the phases must run in this order.
 """
 import argparse
@@ -36,7 +37,8 @@ PHASES = ("common", "config", "reweight")
 # Makefile.example variables, in the order they are written to a job line.
 SEQUENCE_VARS = ("DATASET", "GT", "PRIOR", "ODOM_N")  # fixed per sequence (common phase)
 UPSTREAM_VARS = ("N", "V_INTERVAL")  # change direction_cluster / visual_assoc / local_map
-REWEIGHT_VARS = ("ALPHA", "BETA", "GAMMA", "GLOBAL_OPTS", "ALIGN")  # global_opt + evaluate
+# global_opt + evaluate (and the re-association passes p > 1, which live in the task's own folder)
+REWEIGHT_VARS = ("ALPHA", "BETA", "GAMMA", "GLOBAL_OPTS", "ALIGN", "PASSES")
 OTHER_VARS = ("THREADS", "BIN")
 KNOWN_VARS = SEQUENCE_VARS + UPSTREAM_VARS + REWEIGHT_VARS + OTHER_VARS
 

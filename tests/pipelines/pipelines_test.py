@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Batch pipelines without running a stage: job-list generation, the per-task make command, the
 batch makefile, the Slurm submission (dry run), the collect step on committed metrics and the
-gains table on a hand-made run.
+gains table on a hand-made run, and Makefile.example's re-association passes (make -n).
 
     python3 tests/pipelines/pipelines_test.py      (from the repository root; CTest does this)
 """
@@ -190,6 +190,82 @@ class Collect(unittest.TestCase):
 
 def kitti_line(x, z):
     return f"1 0 0 {x} 0 1 0 0 0 0 1 {z}\n"
+
+
+class MakefilePasses(unittest.TestCase):
+    """Makefile.example's PASSES, from the commands `make -n` would run."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp()
+        self.bin = os.path.join(self.dir, "bin")
+        os.makedirs(self.bin)
+        for tool in ("lidar_odom", "vp_detect", "direction_cluster", "visual_assoc", "local_map",
+                     "global_opt", "evaluate"):
+            open(os.path.join(self.bin, tool), "w").close()
+        self.out = os.path.join(self.dir, "out")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def commands(self, *variables):
+        out = run(["make", "-n", "--no-print-directory", "-f", "Makefile.example",
+                   "BIN=" + self.bin, "OUT=" + self.out, "DATASET=" + self.dir + "/seq"] +
+                  list(variables))
+        self.assertEqual(out.returncode, 0, out.stderr)
+        # Join continuation lines: one command per entry.
+        return [l for l in out.stdout.replace("\\\n", " ").splitlines() if l.strip()]
+
+    def tool_runs(self, commands, tool):
+        return [c for c in commands if c.startswith(os.path.join(self.bin, tool) + " ")]
+
+    def test_single_pass_is_the_papers_chain(self):
+        c = self.commands("PASSES=1")
+        self.assertEqual(len(self.tool_runs(c, "visual_assoc")), 1)
+        runs = self.tool_runs(c, "global_opt")
+        self.assertEqual(len(runs), 2)
+        self.assertTrue(any(f"--kitti-poses {self.out}/with_directions.txt" in r for r in runs))
+        self.assertTrue(any(f"--kitti-poses {self.out}/without_directions.txt" in r for r in runs))
+        evaluate = self.tool_runs(c, "evaluate")[0]
+        self.assertIn(f"--est {self.out}/global.h5 ", evaluate)
+
+    def test_default_second_pass_starts_from_the_first_result_without_directions(self):
+        c = self.commands()
+        visual = self.tool_runs(c, "visual_assoc")
+        self.assertEqual(len(visual), 2)
+        self.assertIn(f"--prior {self.out}/odom.h5 ", visual[0])
+        self.assertIn(f"--prior {self.out}/global_nodir.h5 ", visual[1])
+        self.assertIn(f"-o {self.out}/pass2/visual.h5", visual[1])
+        cluster = self.tool_runs(c, "direction_cluster")
+        self.assertIn(f"--prior {self.out}/global_nodir.h5 ", cluster[1])
+        runs = self.tool_runs(c, "global_opt")
+        # Pass 1 only without direction priors (the next pass's prior), pass 2 both.
+        self.assertEqual(len(runs), 3)
+        self.assertEqual(sum("--vps" in r for r in runs), 1)
+        self.assertTrue(any(f"--kitti-poses {self.out}/pass1/without_directions.txt" in r
+                            for r in runs))
+        self.assertTrue(any(f"-o {self.out}/pass2/global.h5 " in r and
+                            f"--kitti-poses {self.out}/with_directions.txt" in r for r in runs))
+        evaluate = self.tool_runs(c, "evaluate")[0]
+        self.assertIn(f"--est {self.out}/odom.h5 --label prior", evaluate)
+        self.assertIn(f"--est {self.out}/pass2/global_nodir.h5 ", evaluate)
+        self.assertIn(f"--est {self.out}/pass2/global.h5 ", evaluate)
+
+    def test_passes_chain_their_priors(self):
+        c = self.commands("PASSES=3")
+        visual = self.tool_runs(c, "visual_assoc")
+        self.assertEqual(len(visual), 3)
+        self.assertIn(f"--prior {self.out}/pass2/global_nodir.h5 ", visual[2])
+
+    def test_gamma_does_not_change_the_runs_without_direction_priors(self):
+        c = self.commands("GAMMA=7")
+        runs = self.tool_runs(c, "global_opt")
+        self.assertTrue(all(("--gamma 7" in r) == ("--vps" in r) for r in runs))
+
+    def test_bad_passes(self):
+        out = run(["make", "-n", "-f", "Makefile.example", "BIN=" + self.bin, "OUT=" + self.out,
+                   "PASSES=0"])
+        self.assertNotEqual(out.returncode, 0)
+        self.assertIn("PASSES must be 1..9", out.stderr)
 
 
 class GainsTable(unittest.TestCase):
