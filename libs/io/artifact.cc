@@ -32,15 +32,25 @@ std::string UtcNow() {
 template <typename T>
 hid_t NativeType();
 template <>
-hid_t NativeType<double>() { return H5T_NATIVE_DOUBLE; }
+hid_t NativeType<double>() {
+  return H5T_NATIVE_DOUBLE;
+}
 template <>
-hid_t NativeType<float>() { return H5T_NATIVE_FLOAT; }
+hid_t NativeType<float>() {
+  return H5T_NATIVE_FLOAT;
+}
 template <>
-hid_t NativeType<int64_t>() { return H5T_NATIVE_INT64; }
+hid_t NativeType<int64_t>() {
+  return H5T_NATIVE_INT64;
+}
 template <>
-hid_t NativeType<int32_t>() { return H5T_NATIVE_INT32; }
+hid_t NativeType<int32_t>() {
+  return H5T_NATIVE_INT32;
+}
 template <>
-hid_t NativeType<uint8_t>() { return H5T_NATIVE_UINT8; }
+hid_t NativeType<uint8_t>() {
+  return H5T_NATIVE_UINT8;
+}
 
 // Closes an HDF5 handle when it goes out of scope.
 class Handle {
@@ -280,8 +290,8 @@ void H5Writer::Commit(const Provenance& provenance) {
   JVL_CHECK(closed >= 0, impl_->path << ": closing the HDF5 file failed (disk full?)");
   std::error_code ec;
   std::filesystem::rename(impl_->tmp, impl_->path, ec);
-  JVL_CHECK(!ec, impl_->path << ": cannot move the finished file into place (" << ec.message()
-                             << ")");
+  JVL_CHECK(!ec,
+            impl_->path << ": cannot move the finished file into place (" << ec.message() << ")");
   impl_->committed = true;
 }
 
@@ -335,8 +345,8 @@ void H5Reader::CheckSchema(const std::string& schema, int schema_version) {
   impl_->version = static_cast<int>(*found_version);
   if (!schema.empty()) {
     JVL_CHECK(impl_->schema == schema && impl_->version == schema_version,
-              p << ": expected schema '" << schema << "' version " << schema_version
-                << ", found '" << impl_->schema << "' version " << impl_->version);
+              p << ": expected schema '" << schema << "' version " << schema_version << ", found '"
+                << impl_->schema << "' version " << impl_->version);
   }
 }
 
@@ -344,9 +354,7 @@ H5Reader::~H5Reader() {
   if (impl_ && impl_->file >= 0) H5Fclose(impl_->file);
 }
 
-bool H5Reader::Has(const std::string& name) const {
-  return LinkExists(impl_->file, name);
-}
+bool H5Reader::Has(const std::string& name) const { return LinkExists(impl_->file, name); }
 
 std::vector<int64_t> H5Reader::Dims(const std::string& name) const {
   JVL_CHECK(Has(name), impl_->path << ": missing dataset '" << name << "'");
@@ -367,18 +375,22 @@ std::string H5Reader::DatasetType(const std::string& name) const {
   Handle type(H5Dget_type(ds.get()), H5Tclose);
   const size_t bits = 8 * H5Tget_size(type.get());
   switch (H5Tget_class(type.get())) {
-    case H5T_FLOAT: return "float" + std::to_string(bits);
+    case H5T_FLOAT:
+      return "float" + std::to_string(bits);
     case H5T_INTEGER:
       return (H5Tget_sign(type.get()) == H5T_SGN_NONE ? "uint" : "int") + std::to_string(bits);
-    case H5T_STRING: return "string";
-    default: return "other";
+    case H5T_STRING:
+      return "string";
+    default:
+      return "other";
   }
 }
 
 namespace {
 #if H5_VERSION_GE(1, 12, 0)
 using ObjectInfo = H5O_info2_t;
-#define JVL_H5_VISIT(file, op, data) H5Ovisit3(file, H5_INDEX_NAME, H5_ITER_INC, op, data, H5O_INFO_BASIC)
+#define JVL_H5_VISIT(file, op, data) \
+  H5Ovisit3(file, H5_INDEX_NAME, H5_ITER_INC, op, data, H5O_INFO_BASIC)
 #else
 using ObjectInfo = H5O_info_t;
 #define JVL_H5_VISIT(file, op, data) H5Ovisit(file, H5_INDEX_NAME, H5_ITER_INC, op, data)
@@ -439,6 +451,25 @@ std::vector<T> H5Reader::ReadArray(const std::string& name, int64_t expected_col
   std::vector<T> out(static_cast<size_t>(count));
   if (count == 0) return out;
   Handle ds(H5Dopen2(impl_->file, name.c_str(), H5P_DEFAULT), H5Dclose);
+  JVL_CHECK(ds.ok(), impl_->path << ": cannot open dataset '" << name << "' (damaged file?)");
+  // Unchunked data is stored whole: a damaged header can declare fewer stored bytes than the
+  // shape needs, and libhdf5 then copies from a missing buffer (a crash, found by the artifact
+  // fuzzer) instead of failing. Chunked data may be compressed, so its size says nothing.
+  Handle plist(H5Dget_create_plist(ds.get()), H5Pclose);
+  Handle type(H5Dget_type(ds.get()), H5Tclose);
+  JVL_CHECK(plist.ok() && type.ok(),
+            impl_->path << ": cannot read the layout of dataset '" << name << "' (damaged file?)");
+  const H5D_layout_t layout = H5Pget_layout(plist.get());
+  JVL_CHECK(
+      layout == H5D_CONTIGUOUS || layout == H5D_CHUNKED || layout == H5D_COMPACT,
+      impl_->path << ": dataset '" << name << "' has an unknown storage layout (damaged file?)");
+  if (layout != H5D_CHUNKED) {
+    const uint64_t stored = H5Dget_storage_size(ds.get());
+    const uint64_t needed = static_cast<uint64_t>(count) * H5Tget_size(type.get());
+    JVL_CHECK(stored == needed, impl_->path << ": dataset '" << name << "' stores " << stored
+                                            << " bytes for " << count << " values of "
+                                            << H5Tget_size(type.get()) << " bytes (damaged file?)");
+  }
   JVL_CHECK(H5Dread(ds.get(), NativeType<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) >= 0,
             impl_->path << ": cannot read dataset '" << name << "' (damaged file?)");
   return out;
@@ -539,11 +570,11 @@ nlohmann::json ReadJsonArtifact(const std::string& path, const std::string& sche
   JVL_CHECK(j.is_object() && j.contains("schema") && j.contains("schema_version"),
             path << ": not a jvl artifact (no schema field); expected schema '" << schema << "'");
   const std::string found = j["schema"].is_string() ? j["schema"].get<std::string>() : "?";
-  const int found_version = j["schema_version"].is_number_integer()
-                                ? j["schema_version"].get<int>() : -1;
+  const int found_version =
+      j["schema_version"].is_number_integer() ? j["schema_version"].get<int>() : -1;
   JVL_CHECK(found == schema && found_version == schema_version,
-            path << ": expected schema '" << schema << "' version " << schema_version
-                 << ", found '" << found << "' version " << found_version);
+            path << ": expected schema '" << schema << "' version " << schema_version << ", found '"
+                 << found << "' version " << found_version);
   return j;
 }
 
