@@ -92,7 +92,8 @@ nlohmann::json DescribeScene(const World& world) {
                   {"straights_ge_100m", rs.straights_100m},
                   {"turns", rs.turns},
                   {"sharp_turns", rs.sharp_turns},
-                  {"stop_at_s", world.options.drive.stop_at_s}};
+                  {"stop_at_s", world.options.drive.stop_at_s},
+                  {"steer_transition_m", world.options.drive.steer_transition}};
   nlohmann::json pieces = nlohmann::json::array();
   for (const RoadPiece& p : sc.route.pieces()) {
     pieces.push_back({{"type", p.IsStraight() ? "straight" : "arc"},

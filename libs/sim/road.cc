@@ -218,8 +218,11 @@ std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps) {
 
 void DriveOptions::Check() const {
   JVL_CHECK(frame_rate_hz > 0, "frame_rate_hz must be > 0, got " << frame_rate_hz);
-  JVL_CHECK(max_accel > 0 && max_decel > 0, "max_accel and max_decel must be > 0, got " << max_accel << " and " << max_decel);
+  JVL_CHECK(max_accel > 0 && max_decel > 0,
+            "max_accel and max_decel must be > 0, got " << max_accel << " and " << max_decel);
   JVL_CHECK(stop_duration >= 0, "stop_duration must be >= 0, got " << stop_duration);
+  JVL_CHECK(std::isfinite(steer_transition) && steer_transition >= 0 && steer_transition <= 100,
+            "steer_transition must be in [0, 100] m, got " << steer_transition);
 }
 
 Drive PlanDrive(const Route& route, const DriveOptions& options) {
@@ -270,12 +273,58 @@ double DriveArcLength(const Drive& drive, double t) {
   return drive.s[i] + u * (drive.s[i + 1] - drive.s[i]);
 }
 
+namespace {
+
+// Centre line at arc length s, continued straight beyond both ends of the route.
+Eigen::Vector2d CentreLine(const Route& route, double s, double* heading) {
+  const RoadPoint r = route.At(s);
+  *heading = r.heading;
+  const double beyond = s < 0 ? s : std::max(0.0, s - route.length());
+  return r.position + beyond * Eigen::Vector2d(std::cos(r.heading), std::sin(r.heading));
+}
+
+struct PathPoint {
+  Eigen::Vector2d position;
+  double heading = 0;
+  double curvature = 0;
+};
+
+// The centre line averaged over [s - window/2, s + window/2]. Its tangent is the chord between
+// the window's ends and its curvature the heading change across the window over its length, so
+// a straight-to-arc step of the road becomes a linear ramp of the curvature over `window`.
+// The average itself is a midpoint rule (error below a millimetre for the route's radii).
+PathPoint SmoothedPath(const Route& route, double s, double window) {
+  PathPoint out;
+  if (window <= 0) {
+    const RoadPoint r = route.At(s);
+    out.position = r.position;
+    out.heading = r.heading;
+    out.curvature = r.curvature;
+    return out;
+  }
+  constexpr int kSamples = 16;
+  double h = 0;
+  out.position.setZero();
+  for (int i = 0; i < kSamples; ++i) {
+    out.position += CentreLine(route, s + window * ((i + 0.5) / kSamples - 0.5), &h);
+  }
+  out.position /= kSamples;
+  double h0 = 0, h1 = 0;
+  const Eigen::Vector2d chord =
+      CentreLine(route, s + window / 2, &h1) - CentreLine(route, s - window / 2, &h0);
+  out.heading = std::atan2(chord.y(), chord.x());
+  out.curvature = std::remainder(h1 - h0, 2 * kPi) / window;
+  return out;
+}
+
+}  // namespace
+
 Rigid3d VehiclePose(const Route& route, const Terrain& terrain, const Drive& drive,
                     const DriveOptions& options, double t, uint64_t seed) {
   const double s = DriveArcLength(drive, t);
   const double x = std::clamp(t / drive.dt, 0.0, static_cast<double>(drive.v.size() - 1));
   const double v = drive.v[static_cast<size_t>(x)];
-  const RoadPoint rp = route.At(s);
+  const PathPoint rp = SmoothedPath(route, s, options.steer_transition);
   // Lane keeping: a slow weave around the lane centre; the heading follows its derivative.
   const double phase = 6.283185307 * HashUnit(1, 2, seed);
   const double w = 2 * kPi / 70.0;

@@ -88,6 +88,12 @@ struct DriveOptions {
   double lane_wobble = 0.12;   // Amplitude (m) of lane-keeping weaving.
   double stop_at_s = -1;       // Arc length of a stop (< 0: no stop).
   double stop_duration = 3.0;  // s
+  // The vehicle's path is the lane averaged over this arc length (m): its curvature, the yaw rate
+  // and the body roll ramp over it where the road steps from straight to arc. Following the
+  // centre line exactly (0) steps the yaw rate and the roll within one instant; a sweep of a
+  // moving LiDAR that straddles that instant is bent in a way no motion model can undo. Default
+  // from the KITTI ground truth (docs/sim.md "Vehicle motion").
+  double steer_transition = 6.0;
   void Check() const;
 };
 

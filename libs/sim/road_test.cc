@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sim/describe.h"
 #include "sim/prior.h"
@@ -103,6 +104,59 @@ TEST(DriveTest, StopHoldsTheVehicle) {
     still += (gt[k].translation() - gt[k - 1].translation()).norm() < 0.01 ? 1 : 0;
   }
   EXPECT_GE(still, 20);  // About 3 s at 10 Hz.
+}
+
+// Largest change of the yaw rate (rad/s) between consecutive 10 ms steps of the urban drive, and
+// the largest angle (rad) between the vehicle's heading and its direction of motion.
+struct YawRateChange {
+  double max_change = 0;
+  double max_slip = 0;
+};
+
+YawRateChange MeasureYawRate(double steer_transition) {
+  const Route route(ScenarioRoute(Scenario::kUrban), Eigen::Vector2d::Zero(), 0.0);
+  DriveOptions options;
+  options.steer_transition = steer_transition;
+  const Drive drive = PlanDrive(route, options);
+  const Terrain terrain;
+  const auto yaw_at = [&](double t) {
+    const Eigen::Matrix3d R = VehiclePose(route, terrain, drive, options, t, 7).RotationMatrix();
+    return std::atan2(R(1, 0), R(0, 0));
+  };
+  YawRateChange out;
+  const double dt = 0.01;
+  double previous_rate = std::numeric_limits<double>::quiet_NaN();
+  for (double t = dt; t < drive.duration() - dt; t += dt) {
+    const double rate = std::remainder(yaw_at(t + dt) - yaw_at(t), 2 * M_PI) / dt;
+    if (std::isfinite(previous_rate)) {
+      out.max_change = std::max(out.max_change, std::abs(rate - previous_rate));
+    }
+    previous_rate = rate;
+    const Eigen::Vector3d step =
+        VehiclePose(route, terrain, drive, options, t + dt, 7).translation() -
+        VehiclePose(route, terrain, drive, options, t - dt, 7).translation();
+    if (step.head<2>().norm() > 1e-3) {
+      const double motion = std::atan2(step.y(), step.x());
+      out.max_slip = std::max(out.max_slip, std::abs(std::remainder(motion - yaw_at(t), 2 * M_PI)));
+    }
+  }
+  return out;
+}
+
+// Where a straight meets a 12 m corner, following the centre line steps the yaw rate by v k
+// (about 0.6 rad/s) within one instant; the steering transition ramps it over 6 m, so between
+// 10 ms steps it changes by v^2 k / 6 m * 10 ms (below 0.01 rad/s). The heading stays the
+// direction of motion either way (no side slip beyond the lane-keeping weave's).
+TEST(DriveTest, SteerTransitionRampsTheYawRate) {
+  const YawRateChange stepped = MeasureYawRate(0.0);
+  const YawRateChange ramped = MeasureYawRate(6.0);
+  EXPECT_GT(stepped.max_change, 0.3);
+  EXPECT_LT(ramped.max_change, 0.02);
+  EXPECT_LT(stepped.max_slip, 0.01);
+  EXPECT_LT(ramped.max_slip, 0.01);
+  DriveOptions bad;
+  bad.steer_transition = -1;
+  EXPECT_THROW(bad.Check(), std::exception);
 }
 
 TEST(PriorTest, PresetsDriftAsAdvertised) {

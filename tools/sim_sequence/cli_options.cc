@@ -10,6 +10,9 @@ void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
             "Drive the route this many times, every second lap mirrored (long sequences)");
   route.Add("--seed", o->seed, "Random seed (world layout and noise)");
   route.Flag("--stop", o->stop, "Stop for a few seconds before the second corner");
+  route.Add("--steer-transition", o->drive.steer_transition,
+            "Arc length (m) over which the vehicle's curvature, yaw rate and body roll ramp into "
+            "and out of a turn (0: they step where the road does)");
 
   app::OptionGroup sensors(tool, "Sensors");
   sensors.Add("--range-noise", o->lidar.range_noise, "LiDAR range noise sigma (m)");
