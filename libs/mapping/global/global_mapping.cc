@@ -19,6 +19,8 @@
 #include "lidar/imls.h"
 #include "lidar/surface.h"
 #include "lidar/voxel_grid.h"
+#include "optim/cost_functions.h"
+#include "optim/pose_block.h"
 
 namespace jvl::mapping {
 
@@ -285,16 +287,16 @@ struct OdometryTerm {
   std::vector<optim::RelativePoseConstraint> constraints;  // keyframe rows i, i + 1
 };
 
-// The residual of E = Z^-1 (T_i^-1 T_j) per axis, [2 vec(q_E); t_E] (RelativePoseCost without
-// its whitening), per frame of the interval (divided by sqrt(frames)).
+// The residual of E = Z^-1 (T_i^-1 T_j) per axis, [2 vec(q_E); t_E] (optim::RelativePoseCost with
+// unit whitening), per frame of the interval (divided by sqrt(frames)).
 Eigen::Matrix<double, 6, 1> RelativeError(const optim::RelativePoseConstraint& c,
                                           const Trajectory& keyframes, int64_t frames) {
-  const Rigid3d e = c.i_from_j.Inverse() *
-                    (keyframes.world_from_cam[c.i].Inverse() * keyframes.world_from_cam[c.j]);
-  Eigen::Quaterniond q = e.rotation();
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  const optim::RelativePoseCost cost(c.i_from_j.rotation(), c.i_from_j.translation(),
+                                     Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones());
+  const optim::PoseBlock i = optim::ToPoseBlock(keyframes.world_from_cam[c.i]);
+  const optim::PoseBlock j = optim::ToPoseBlock(keyframes.world_from_cam[c.j]);
   Eigen::Matrix<double, 6, 1> r;
-  r << 2.0 * q.vec(), e.translation();
+  cost(i.data(), j.data(), r.data());
   return r / std::sqrt(static_cast<double>(std::max<int64_t>(frames, 1)));
 }
 
@@ -721,11 +723,14 @@ nlohmann::json ChangeJson(const std::map<int32_t, double>& change) {
   return j;
 }
 
+nlohmann::json VectorJson(const Eigen::Vector3d& v) {
+  return nlohmann::json::array({v.x(), v.y(), v.z()});
+}
+
 nlohmann::json FreeJson(const GlobalMappingResult& r) {
   nlohmann::json j = nlohmann::json::object();
   for (size_t i = 0; i < r.free_directions.size() && i < r.free_direction_clusters.size(); ++i) {
-    const Eigen::Vector3d& d = r.free_directions[i];
-    j[std::to_string(r.free_direction_clusters[i])] = {d.x(), d.y(), d.z()};
+    j[std::to_string(r.free_direction_clusters[i])] = VectorJson(r.free_directions[i]);
   }
   return j;
 }
@@ -783,19 +788,16 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
         {"outliers", r.vertical_outliers},
         {"sigma_deg", r.vertical_sigma_deg},
         {"rho", r.vertical_rho},
-        {"direction", r.vertical_used > 0 ? nlohmann::json::array({r.vertical_direction.x(),
-                                                                   r.vertical_direction.y(),
-                                                                   r.vertical_direction.z()})
-                                          : nlohmann::json(nullptr)}}},
+        {"direction",
+         r.vertical_used > 0 ? VectorJson(r.vertical_direction) : nlohmann::json(nullptr)}}},
       {"odometry",
        {{"enabled", o.use_odometry},
         {"pairs", r.odometry_pairs},
         {"gate", o.odometry_gate},
         {"gated", r.odometry_gated},
         {"outliers", r.odometry_outliers},
-        {"sigma_m", {r.odometry_sigma_m.x(), r.odometry_sigma_m.y(), r.odometry_sigma_m.z()}},
-        {"sigma_deg",
-         {r.odometry_sigma_deg.x(), r.odometry_sigma_deg.y(), r.odometry_sigma_deg.z()}},
+        {"sigma_m", VectorJson(r.odometry_sigma_m)},
+        {"sigma_deg", VectorJson(r.odometry_sigma_deg)},
         {"cauchy", o.joint.relative_cauchy}}},
       {"solver",
        {{"usable", s.usable},
