@@ -73,21 +73,76 @@ Route::Route(std::vector<RoadPiece> pieces, const Eigen::Vector2d& start, double
     p = end.position;
     h = end.heading;
     length_ += piece.length;
+    piece_ends_.push_back(length_);
+    all_pieces_.push_back(static_cast<int>(i));
   }
+  // Grid index for Project(): a cell lists the pieces whose bounding circle comes within
+  // kIndexReach of some point of the cell.
+  const double half_diagonal = kIndexCell * std::sqrt(0.5);
+  for (size_t i = 0; i < pieces_.size(); ++i) {
+    const double reach = pieces_[i].length / 2 + kIndexReach + half_diagonal;
+    const Eigen::Vector2d& mid = cache_[i].mid;
+    const int64_t x0 = CellIndex(mid.x() - reach), x1 = CellIndex(mid.x() + reach);
+    const int64_t y0 = CellIndex(mid.y() - reach), y1 = CellIndex(mid.y() + reach);
+    for (int64_t x = x0; x <= x1; ++x) {
+      for (int64_t y = y0; y <= y1; ++y) {
+        const Eigen::Vector2d centre((static_cast<double>(x) + 0.5) * kIndexCell,
+                                     (static_cast<double>(y) + 0.5) * kIndexCell);
+        if ((centre - mid).norm() <= reach) index_[CellKey(x, y)].push_back(static_cast<int>(i));
+      }
+    }
+  }
+}
+
+int64_t Route::CellIndex(double v) { return static_cast<int64_t>(std::floor(v / kIndexCell)); }
+
+uint64_t Route::CellKey(int64_t x, int64_t y) {
+  return (static_cast<uint64_t>(x) << 32) ^ (static_cast<uint64_t>(y) & 0xffffffffULL);
+}
+
+uint64_t Route::CellKey(const Eigen::Vector2d& p) {
+  return CellKey(CellIndex(p.x()), CellIndex(p.y()));
 }
 
 RoadPoint Route::At(double s) const {
   s = std::clamp(s, 0.0, length_);
-  size_t i = 0;
-  while (i + 1 < pieces_.size() && s > pieces_[i].s0 + pieces_[i].length) ++i;
+  const size_t i = PieceIndex(s);
   return PieceAt(pieces_[i], static_cast<int>(i), s - pieces_[i].s0);
 }
 
+size_t Route::PieceIndex(double s) const {
+  // The first piece whose end is at or beyond s (the earlier piece at a shared end).
+  const auto it = std::lower_bound(piece_ends_.begin(), piece_ends_.end(), s);
+  return std::min(static_cast<size_t>(it - piece_ends_.begin()), pieces_.size() - 1);
+}
+
+std::pair<size_t, size_t> Route::PiecesStartingIn(double lo, double hi) const {
+  const auto starts_after = [](const RoadPiece& piece, double v) { return piece.s0 <= v; };
+  const auto first = std::lower_bound(pieces_.begin(), pieces_.end(), lo, starts_after);
+  const auto last = std::lower_bound(first, pieces_.end(), hi,
+                                     [](const RoadPiece& piece, double v) { return piece.s0 < v; });
+  return {static_cast<size_t>(first - pieces_.begin()),
+          static_cast<size_t>(last - pieces_.begin())};
+}
+
 void Route::Project(const Eigen::Vector2d& p, double* s, double* lateral) const {
+  // The pieces of p's grid cell hold every piece within kIndexReach of p; when the nearest of
+  // them is that close, no other piece can be nearer (the full loop would give the same result,
+  // ties included: both visit the pieces in route order).
+  const auto cell = index_.find(CellKey(p));
+  if (cell != index_.end()) {
+    ProjectOnto(p, cell->second, s, lateral);
+    if (std::abs(*lateral) <= kIndexReach) return;
+  }
+  ProjectOnto(p, all_pieces_, s, lateral);
+}
+
+void Route::ProjectOnto(const Eigen::Vector2d& p, const std::vector<int>& candidates, double* s,
+                        double* lateral) const {
   double best = std::numeric_limits<double>::infinity();
   *s = 0;
   *lateral = best;
-  for (size_t i = 0; i < pieces_.size(); ++i) {
+  for (const int i : candidates) {
     const RoadPiece& piece = pieces_[i];
     const Cache& c = cache_[i];
     // Every point of the piece lies within length/2 of its mid point.

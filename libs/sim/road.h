@@ -5,7 +5,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "geometry/rigid3.h"
@@ -45,8 +48,22 @@ class Route {
   // arc length and signed lateral offset (left +).
   void Project(const Eigen::Vector2d& p, double* s, double* lateral) const;
   double Distance(const Eigen::Vector2d& p) const;
+  // Index of the piece holding arc length s (clamped; at a shared end, the earlier piece).
+  size_t PieceIndex(double s) const;
+  // Range [first, last) of the pieces whose start s0 lies in (lo, hi).
+  std::pair<size_t, size_t> PiecesStartingIn(double lo, double hi) const;
 
  private:
+  // Project() looks among the pieces of p's cell of a grid first (exact where one of them is
+  // within kIndexReach, else all pieces): cost independent of the route's length.
+  static constexpr double kIndexCell = 16.0;   // m
+  static constexpr double kIndexReach = 40.0;  // m
+  static int64_t CellIndex(double v);
+  static uint64_t CellKey(int64_t x, int64_t y);
+  static uint64_t CellKey(const Eigen::Vector2d& p);
+  void ProjectOnto(const Eigen::Vector2d& p, const std::vector<int>& candidates, double* s,
+                   double* lateral) const;
+
   // Per-piece constants for Project(): unit start direction, circle centre and radius (arcs),
   // end point and heading, and a bounding circle (mid point, radius length/2).
   struct Cache {
@@ -55,6 +72,9 @@ class Route {
   };
   std::vector<RoadPiece> pieces_;
   std::vector<Cache> cache_;
+  std::vector<double> piece_ends_;  // s0 + length of each piece
+  std::vector<int> all_pieces_;     // 0 .. pieces - 1
+  std::unordered_map<uint64_t, std::vector<int>> index_;
   double length_ = 0;
 };
 

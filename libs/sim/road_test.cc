@@ -8,6 +8,7 @@
 
 #include "sim/describe.h"
 #include "sim/prior.h"
+#include "sim/random.h"
 #include "sim/sequence.h"
 
 namespace jvl::sim {
@@ -38,6 +39,47 @@ TEST(RouteTest, PiecesJoinContinuously) {
     const double s = route.pieces()[i].s0;
     EXPECT_LT((route.At(s - 1e-7).position - route.At(s + 1e-7).position).norm(), 1e-5);
   }
+}
+
+// Project() looks up a grid cell's pieces first; the nearest centre-line point must still be the
+// nearest over the whole route, near the road and far from it (where it falls back to all pieces).
+TEST(RouteTest, ProjectFindsTheNearestPieceOnALongRoute) {
+  const Route route(ScenarioRoute(Scenario::kUrban, 9), Eigen::Vector2d(3, -2), 0.35);
+  std::vector<Eigen::Vector2d> samples;
+  for (double s = 0; s <= route.length(); s += 0.05) samples.push_back(route.At(s).position);
+  Rng rng(3);
+  int far = 0;
+  for (int k = 0; k < 400; ++k) {
+    const RoadPoint rp = route.At(rng.Uniform() * route.length());
+    const double off = (k % 4 == 0 ? 150.0 : 30.0) * (2 * rng.Uniform() - 1);
+    const Eigen::Vector2d p =
+        rp.position + Eigen::Vector2d(off * rng.Uniform(), off * (2 * rng.Uniform() - 1));
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector2d& q : samples) nearest = std::min(nearest, (p - q).norm());
+    double s, lateral;
+    route.Project(p, &s, &lateral);
+    EXPECT_LE(std::abs(lateral), nearest + 1e-9) << "point " << p.transpose();
+    EXPECT_GE(std::abs(lateral), nearest - 0.03) << "point " << p.transpose();
+    EXPECT_NEAR((route.At(s).position - p).norm(), std::abs(lateral), 1e-6);
+    far += nearest > 40 ? 1 : 0;
+  }
+  EXPECT_GT(far, 10);  // The fallback to all pieces was exercised.
+}
+
+TEST(RouteTest, PieceIndexAndPiecesStartingIn) {
+  const Route route(ScenarioRoute(Scenario::kUrban), Eigen::Vector2d::Zero(), 0.0);
+  const auto& pieces = route.pieces();
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    EXPECT_EQ(route.PieceIndex(pieces[i].s0 + 0.5 * pieces[i].length), i);
+    const auto [first, last] = route.PiecesStartingIn(pieces[i].s0 - 0.1, pieces[i].s0 + 0.1);
+    EXPECT_EQ(first, i);
+    EXPECT_EQ(last, i + 1);
+  }
+  EXPECT_EQ(route.PieceIndex(pieces[1].s0), 0u);  // A shared end belongs to the earlier piece.
+  EXPECT_EQ(route.PieceIndex(-5), 0u);
+  EXPECT_EQ(route.PieceIndex(route.length() + 5), pieces.size() - 1);
+  const auto [first, last] = route.PiecesStartingIn(route.length(), route.length() + 10);
+  EXPECT_EQ(first, last);
 }
 
 TEST(RouteTest, StraightScenarioIsOneLongStraight) {

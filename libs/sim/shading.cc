@@ -35,11 +35,11 @@ Surface ShadeGround(const Scene& scene, const Eigen::Vector3d& p, double footpri
     bool mark = std::abs(a - 3.5) < 0.08;                     // Solid lane edge lines.
     mark = mark || (a < 0.07 && Fract(s / 9.0) < 1.0 / 3.0);  // Dashed centre line 3 m / 6 m.
     // Zebra crossings 6-10 m before every sharp corner.
-    for (const RoadPiece& piece : scene.route.pieces()) {
+    const auto [first, last] = scene.route.PiecesStartingIn(s + 6, s + 10);
+    for (size_t i = first; i < last; ++i) {
+      const RoadPiece& piece = scene.route.pieces()[i];
       if (piece.IsStraight() || std::abs(piece.curvature) < 0.05) continue;
-      if (s > piece.s0 - 10 && s < piece.s0 - 6 && a < 3.3 && Fract((lat + 10) / 1.0) < 0.5) {
-        mark = true;
-      }
+      if (a < 3.3 && Fract((lat + 10) / 1.0) < 0.5) mark = true;
     }
     if (mark) {
       out.albedo = static_cast<float>(0.82 + 0.04 * fine);
