@@ -6,6 +6,7 @@ gains table on a hand-made run, and Makefile.example's re-association passes (ma
     python3 tests/pipelines/pipelines_test.py      (from the repository root; CTest does this)
 """
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -19,6 +20,7 @@ SPEC = os.path.join(DATA, "small.spec")
 JOBS_PY = os.path.join(ROOT, "pipelines", "jobs.py")
 COLLECT_PY = os.path.join(ROOT, "pipelines", "collect.py")
 GAINS_PY = os.path.join(ROOT, "pipelines", "gains_table.py")
+FIDELITY_PY = os.path.join(ROOT, "scripts", "sim_fidelity.py")
 
 
 def run(args, **kwargs):
@@ -325,6 +327,57 @@ class GainsTable(unittest.TestCase):
         self.assertAlmostEqual(d1["worst_step"]["without_m"], 0.1, places=6)
         self.assertTrue(rows[1]["missing"])
         self.assertIn("| d1 | 21 | 0.02 |", read(os.path.join(self.run_dir, "gains.md")))
+
+
+class SimFidelity(unittest.TestCase):
+    """scripts/sim_fidelity.py on hand-made drives: a yaw rate that steps and one that ramps."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp()
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def drive(self, name, yaw_rates_deg):
+        # 1 m per frame along the camera's z axis, turning about its y axis (down).
+        path = os.path.join(self.dir, name)
+        x = z = heading = 0.0
+        with open(path, "w") as f:
+            for rate in [0.0] + yaw_rates_deg:
+                heading += math.radians(rate)
+                c, s = math.cos(heading), math.sin(heading)
+                x += s
+                z += c
+                f.write(f"{c} 0 {s} {x} 0 1 0 0 {-s} 0 {c} {z}\n")
+        return path
+
+    def test_step_and_ramp(self):
+        step = self.drive("step.txt", [0.0] * 200 + [2.0] * 200)
+        ramp = self.drive("ramp.txt", [0.0] * 200 + [0.25 * k for k in range(1, 9)] + [2.0] * 192)
+        md = os.path.join(self.dir, "table.md")
+        out = run([sys.executable, FIDELITY_PY, "--markdown", md, "step=" + step, "ramp=" + ramp])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        rows = {line.split("|")[1].strip(): [c.strip() for c in line.split("|")[2:-1]]
+                for line in out.stdout.splitlines()[2:]}
+        self.assertEqual(rows["step"][0], "401")
+        self.assertEqual(rows["step"][1], "10.0 / 10.0")      # speed median / max
+        self.assertEqual(rows["step"][2], "2.000 / 2.000")    # yaw per frame p99 / max
+        self.assertEqual(rows["step"][3], "0.000 / 2.000")    # yaw change: one step of 2 deg
+        self.assertEqual(rows["ramp"][3], "0.250 / 0.250")    # ramped in 0.25 deg per frame
+        self.assertEqual(rows["ramp"][4], "0.0000 / 0.000 / 0.000")  # no roll
+        self.assertEqual(read(md), out.stdout)
+
+    def test_bad_input(self):
+        bad = os.path.join(self.dir, "bad.txt")
+        with open(bad, "w") as f:
+            f.write("1 0 0\n")
+        out = run([sys.executable, FIDELITY_PY, "bad=" + bad])
+        self.assertEqual(out.returncode, 1)
+        self.assertIn("expected 12 numbers", out.stderr)
+        out = run([sys.executable, FIDELITY_PY, "missing=" + os.path.join(self.dir, "none.txt")])
+        self.assertEqual(out.returncode, 1)
+        out = run([sys.executable, FIDELITY_PY])
+        self.assertEqual(out.returncode, 2)
 
 
 if __name__ == "__main__":

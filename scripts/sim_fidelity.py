@@ -1,0 +1,139 @@
+#!/usr/bin/env python3
+"""How a simulated drive moves compared with real KITTI drives (docs/sim.md "Vehicle motion").
+
+Usage: scripts/sim_fidelity.py [--markdown FILE] NAME=POSES [NAME=POSES ...]
+
+POSES is a KITTI pose file (3 x 4 cam0-to-world per line, 10 Hz): a real sequence's ground
+truth (e.g. ../shared/data/kitti_odom_eval_reference/gt_poses/09.txt) or a sim_sequence output's
+poses/00.txt. For each drive the statistics of its frame-to-frame motion, in the camera frame
+(x right, y down, z forward), are printed as one row of a Markdown table:
+
+  speed        translation per frame x 10 Hz (m/s): median and max
+  yaw          rotation about the camera's y axis per frame (deg): p99 and max
+  yaw change   change of that between consecutive frames (deg): p99 and max - how fast the
+               vehicle steers into a turn
+  roll, pitch  rotation about z and x per frame (deg): median (the jitter along straights),
+               p99 and max
+
+The drives are read as given; nothing is aligned or resampled (KITTI's frames are 0.103 s apart,
+the simulator's 0.1 s).
+"""
+import math
+import sys
+
+
+def read_poses(path):
+    poses = []
+    with open(path) as f:
+        for line_no, line in enumerate(f, 1):
+            v = line.split()
+            if not v:
+                continue
+            if len(v) != 12:
+                raise ValueError(f"{path}:{line_no}: expected 12 numbers, found {len(v)}")
+            x = [float(t) for t in v]
+            poses.append(([x[0:3], x[4:7], x[8:11]], [x[3], x[7], x[11]]))
+    if len(poses) < 3:
+        raise ValueError(f"{path}: {len(poses)} poses, at least 3 needed")
+    return poses
+
+
+def relative(a, b):
+    """Rotation R_a^T R_b and translation R_a^T (t_b - t_a)."""
+    (ra, ta), (rb, tb) = a, b
+    r = [[sum(ra[k][i] * rb[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    d = [tb[k] - ta[k] for k in range(3)]
+    t = [sum(ra[k][i] * d[k] for k in range(3)) for i in range(3)]
+    return r, t
+
+
+def rotation_vector(r):
+    c = max(-1.0, min(1.0, (r[0][0] + r[1][1] + r[2][2] - 1) / 2))
+    angle = math.acos(c)
+    v = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]]
+    s = 2 * math.sin(angle)
+    f = angle / s if s > 1e-12 else 0.5
+    return [f * x for x in v]
+
+
+def quantile(values, q):
+    s = sorted(values)
+    return s[min(len(s) - 1, int(q * len(s)))]
+
+
+def motion_stats(poses, rate_hz=10.0):
+    steps = [relative(poses[k], poses[k + 1]) for k in range(len(poses) - 1)]
+    rot = [[math.degrees(x) for x in rotation_vector(r)] for r, _ in steps]
+    speed = [math.sqrt(sum(x * x for x in t)) * rate_hz for _, t in steps]
+    yaw = [abs(r[1]) for r in rot]
+    yaw_change = [abs(rot[k + 1][1] - rot[k][1]) for k in range(len(rot) - 1)]
+    roll = [abs(r[2]) for r in rot]
+    pitch = [abs(r[0]) for r in rot]
+    return {
+        "frames": len(poses),
+        "speed_median": quantile(speed, 0.5), "speed_max": max(speed),
+        "yaw_p99": quantile(yaw, 0.99), "yaw_max": max(yaw),
+        "yaw_change_p99": quantile(yaw_change, 0.99), "yaw_change_max": max(yaw_change),
+        "roll_median": quantile(roll, 0.5), "roll_p99": quantile(roll, 0.99), "roll_max": max(roll),
+        "pitch_median": quantile(pitch, 0.5), "pitch_p99": quantile(pitch, 0.99),
+        "pitch_max": max(pitch),
+    }
+
+
+HEADER = ("| drive | frames | speed median / max (m/s) | yaw per frame p99 / max (deg) | "
+          "yaw change p99 / max (deg) | roll per frame median / p99 / max (deg) | "
+          "pitch per frame median / p99 / max (deg) |\n"
+          "|---|---:|---|---|---|---|---|")
+
+
+def row(name, s):
+    return (f"| {name} | {s['frames']} | {s['speed_median']:.1f} / {s['speed_max']:.1f} | "
+            f"{s['yaw_p99']:.3f} / {s['yaw_max']:.3f} | "
+            f"{s['yaw_change_p99']:.3f} / {s['yaw_change_max']:.3f} | "
+            f"{s['roll_median']:.4f} / {s['roll_p99']:.3f} / {s['roll_max']:.3f} | "
+            f"{s['pitch_median']:.4f} / {s['pitch_p99']:.3f} / {s['pitch_max']:.3f} |")
+
+
+def main(argv):
+    markdown = None
+    drives = []
+    args = list(argv)
+    while args:
+        a = args.pop(0)
+        if a in ("-h", "--help"):
+            print(__doc__.strip())
+            return 0
+        if a == "--markdown":
+            if not args:
+                print("sim_fidelity: --markdown needs a file name", file=sys.stderr)
+                return 2
+            markdown = args.pop(0)
+        elif "=" in a:
+            name, path = a.split("=", 1)
+            drives.append((name, path))
+        else:
+            print(f"sim_fidelity: expected NAME=POSES, got '{a}' (--help)", file=sys.stderr)
+            return 2
+    if not drives:
+        print("sim_fidelity: no drives given (NAME=POSES ...; --help)", file=sys.stderr)
+        return 2
+    lines = [HEADER]
+    for name, path in drives:
+        try:
+            lines.append(row(name, motion_stats(read_poses(path))))
+        except (OSError, ValueError) as e:
+            print(f"sim_fidelity: {e}", file=sys.stderr)
+            return 1
+    text = "\n".join(lines) + "\n"
+    sys.stdout.write(text)
+    if markdown:
+        tmp = markdown + ".tmp"
+        with open(tmp, "w") as f:
+            f.write(text)
+        import os
+        os.replace(tmp, markdown)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
