@@ -322,6 +322,10 @@ Drive PlanDrive(const Route& route, const DriveOptions& options) {
 }
 
 double DriveArcLength(const Drive& drive, double t) {
+  // Before the first and after the last sample the vehicle keeps its speed (a LiDAR sweep
+  // reaches 0.05 s beyond both ends of the drive).
+  if (t < 0) return drive.s.front() + drive.v.front() * t;
+  if (t > drive.duration()) return drive.s.back() + drive.v.back() * (t - drive.duration());
   const double x = std::clamp(t / drive.dt, 0.0, static_cast<double>(drive.s.size() - 1));
   const size_t i = std::min(static_cast<size_t>(x), drive.s.size() - 2);
   const double u = x - static_cast<double>(i);
@@ -352,9 +356,8 @@ PathPoint SmoothedPath(const Route& route, double s, double window) {
   PathPoint out;
   if (window <= 0) {
     const RoadPoint r = route.At(s);
-    out.position = r.position;
-    out.heading = r.heading;
-    out.curvature = r.curvature;
+    out.position = CentreLine(route, s, &out.heading);
+    out.curvature = s < 0 || s > route.length() ? 0.0 : r.curvature;
     return out;
   }
   constexpr int kSamples = 16;

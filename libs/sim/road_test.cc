@@ -201,6 +201,22 @@ TEST(DriveTest, SteerTransitionRampsTheYawRate) {
   EXPECT_THROW(bad.Check(), std::exception);
 }
 
+// A motion-distorted sweep reaches 0.05 s before the first frame and after the last: the vehicle
+// keeps moving there instead of standing at the route's ends.
+TEST(DriveTest, SweepsBeyondTheDriveKeepMoving) {
+  const Route route(ScenarioRoute(Scenario::kUrban), Eigen::Vector2d::Zero(), 0.0);
+  const DriveOptions options;
+  const Drive drive = PlanDrive(route, options);
+  const Terrain terrain;
+  const auto position = [&](double t) {
+    return VehiclePose(route, terrain, drive, options, t, 7).translation();
+  };
+  const double end = drive.duration();
+  EXPECT_NEAR((position(0) - position(-0.05)).norm(), 0.05 * drive.v.front(), 1e-3);
+  EXPECT_NEAR((position(end + 0.05) - position(end)).norm(), 0.05 * drive.v.back(), 1e-3);
+  EXPECT_NEAR(DriveArcLength(drive, -0.05), drive.s.front() - 0.05 * drive.v.front(), 1e-12);
+}
+
 TEST(PriorTest, PresetsDriftAsAdvertised) {
   SequenceOptions opt;
   const auto world = BuildWorld(opt);
