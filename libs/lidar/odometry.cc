@@ -92,6 +92,25 @@ RegistrationResult Odometry::Track(const ScanSurface& surface, const Rigid3d& pr
   return reg;
 }
 
+RegistrationResult Odometry::RedoFirstPair(const PreprocessedScan& second,
+                                           const RegistrationResult& raw, ScanSurface* surface,
+                                           int* samples) {
+  const Rigid3d& world_from_first = frames_.front().world_from_cam;
+  const Rigid3d motion = world_from_first.Inverse() * raw.world_from_scan;
+  PreprocessedScan first = std::move(first_scan_);
+  first_scan_ = PreprocessedScan();
+  DeskewScan(motion, &first);
+  const ScanSurface first_surface = ComputeSurface(first.points, options_.surface, threads_);
+  model_.RemoveScan(frames_.front().frame);
+  AddScanToModel(first_surface.points, first_surface.normals, world_from_first,
+                 frames_.front().frame, &model_);
+  PreprocessedScan deskewed = second;
+  DeskewScan(motion, &deskewed);
+  *surface = ComputeSurface(deskewed.points, options_.surface, threads_);
+  const RegistrationResult reg = Track(*surface, raw.world_from_scan, samples);
+  return reg.ok ? reg : raw;
+}
+
 void Odometry::UpdateModel(int64_t frame, const ScanSurface& surface,
                            const Rigid3d& world_from_cam) {
   // Points without a normal have a zero one and are left out.
@@ -116,15 +135,18 @@ OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
   d.preprocess_ms = timer.ElapsedMs();
   const Rigid3d motion = PredictMotion();
   if (options_.deskew && frames_.size() >= 2) DeskewScan(motion, &pre);
-  const ScanSurface surface = ComputeSurface(pre.points, options_.surface, threads_);
+  ScanSurface surface = ComputeSurface(pre.points, options_.surface, threads_);
   d.surface_ms = timer.ElapsedMs() - d.preprocess_ms;
 
   if (frames_.empty()) {
     d.status = FrameStatus::kFirstFrame;
     out.world_from_cam = Rigid3d();
+    if (options_.deskew) first_scan_ = pre;
   } else {
-    const RegistrationResult reg =
-        Track(surface, frames_.back().world_from_cam * motion, &d.samples);
+    RegistrationResult reg = Track(surface, frames_.back().world_from_cam * motion, &d.samples);
+    if (options_.deskew && frames_.size() == 1 && reg.ok) {
+      reg = RedoFirstPair(pre, reg, &surface, &d.samples);
+    }
     out.world_from_cam = reg.world_from_scan;
     d.iterations = reg.iterations;
     d.residual = reg.residual;

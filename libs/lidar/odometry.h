@@ -28,7 +28,7 @@ struct OdometryOptions {
   AssociationOptions association;  // sampling (s = 100: up to 900 points) and Eq. (2)
   RegistrationOptions registration;
   int scan_map_size = 10;  // N: scans kept in the model.
-  bool deskew = false;         // Constant-velocity de-skewing from the point azimuths.
+  bool deskew = false;     // Constant-velocity de-skewing from the point azimuths.
   // Second scan (no motion estimate yet): a coarse registration first runs with the search
   // radius, kernel h, max distance and robust scale multiplied by this (1 = off).
   double initial_search_scale = 4.0;
@@ -86,12 +86,18 @@ class Odometry {
                               const AssociationOptions& association,
                               const RegistrationOptions& options, int* samples) const;
   void UpdateModel(int64_t frame, const ScanSurface& surface, const Rigid3d& world_from_cam);
+  // De-skewing of the first two scans, which have no motion before them: once the second is
+  // registered raw, both are de-skewed with the motion between them, the first is put back into
+  // the model and the second registered again.
+  RegistrationResult RedoFirstPair(const PreprocessedScan& second, const RegistrationResult& raw,
+                                   ScanSurface* surface, int* samples);
 
   Rigid3d cam0_from_velo_;
   OdometryOptions options_;
   int threads_;
   ImlsModel model_;
   std::vector<OdometryFrame> frames_;
+  PreprocessedScan first_scan_;  // Kept until the second scan when de-skewing.
 };
 
 }  // namespace jvl::lidar
