@@ -19,6 +19,7 @@ The drives are read as given; nothing is aligned or resampled (KITTI's frames ar
 the simulator's 0.1 s).
 """
 import math
+import os
 import sys
 
 
@@ -130,7 +131,6 @@ def main(argv):
         tmp = markdown + ".tmp"
         with open(tmp, "w") as f:
             f.write(text)
-        import os
         os.replace(tmp, markdown)
     return 0
 

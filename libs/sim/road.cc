@@ -334,12 +334,15 @@ double DriveArcLength(const Drive& drive, double t) {
 
 namespace {
 
-// Centre line at arc length s, continued straight beyond both ends of the route.
-Eigen::Vector2d CentreLine(const Route& route, double s, double* heading) {
-  const RoadPoint r = route.At(s);
-  *heading = r.heading;
+// Centre line at arc length s, continued straight (curvature 0) beyond both ends of the route.
+RoadPoint CentreLine(const Route& route, double s) {
+  RoadPoint r = route.At(s);
   const double beyond = s < 0 ? s : std::max(0.0, s - route.length());
-  return r.position + beyond * Eigen::Vector2d(std::cos(r.heading), std::sin(r.heading));
+  if (beyond != 0) {
+    r.position += beyond * Eigen::Vector2d(std::cos(r.heading), std::sin(r.heading));
+    r.curvature = 0;
+  }
+  return r;
 }
 
 struct PathPoint {
@@ -353,25 +356,21 @@ struct PathPoint {
 // a straight-to-arc step of the road becomes a linear ramp of the curvature over `window`.
 // The average itself is a midpoint rule (error below a millimetre for the route's radii).
 PathPoint SmoothedPath(const Route& route, double s, double window) {
-  PathPoint out;
   if (window <= 0) {
-    const RoadPoint r = route.At(s);
-    out.position = CentreLine(route, s, &out.heading);
-    out.curvature = s < 0 || s > route.length() ? 0.0 : r.curvature;
-    return out;
+    const RoadPoint r = CentreLine(route, s);
+    return {r.position, r.heading, r.curvature};
   }
   constexpr int kSamples = 16;
-  double h = 0;
+  PathPoint out;
   out.position.setZero();
   for (int i = 0; i < kSamples; ++i) {
-    out.position += CentreLine(route, s + window * ((i + 0.5) / kSamples - 0.5), &h);
+    out.position += CentreLine(route, s + window * ((i + 0.5) / kSamples - 0.5)).position;
   }
   out.position /= kSamples;
-  double h0 = 0, h1 = 0;
-  const Eigen::Vector2d chord =
-      CentreLine(route, s + window / 2, &h1) - CentreLine(route, s - window / 2, &h0);
+  const RoadPoint a = CentreLine(route, s - window / 2), b = CentreLine(route, s + window / 2);
+  const Eigen::Vector2d chord = b.position - a.position;
   out.heading = std::atan2(chord.y(), chord.x());
-  out.curvature = std::remainder(h1 - h0, 2 * kPi) / window;
+  out.curvature = std::remainder(b.heading - a.heading, 2 * kPi) / window;
   return out;
 }
 
