@@ -157,6 +157,33 @@ Eigen::Vector2d MedianAbsDirectionError(const Trajectory& keyframes, const Pinho
   return {UpperMedian(std::move(u)), UpperMedian(std::move(v))};
 }
 
+double DirectionErrorCorrelation(const Trajectory& keyframes, const PinholeCamera& camera,
+                                 const std::vector<VpPrior>& priors,
+                                 const std::vector<int32_t>& clusters) {
+  JVL_CHECK(priors.size() == clusters.size(),
+            "DirectionErrorCorrelation: " << priors.size() << " priors, " << clusters.size()
+                                          << " cluster ids");
+  // Errors per cluster in the priors' order (directions parallel to the image plane skipped).
+  std::map<int32_t, std::vector<Eigen::Vector2d>> by_cluster;
+  for (size_t i = 0; i < priors.size(); ++i) {
+    const auto e = DirectionErrors(keyframes, camera, {priors[i]});
+    if (!e.empty()) by_cluster[clusters[i]].push_back(e.front());
+  }
+  double var = 0, diff = 0;
+  size_t count = 0;
+  for (const auto& [cluster, e] : by_cluster) {
+    if (e.size() < 2) continue;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& x : e) mean += x;
+    mean /= static_cast<double>(e.size());
+    for (const auto& x : e) var += (x - mean).squaredNorm();
+    for (size_t i = 1; i < e.size(); ++i) diff += (e[i] - e[i - 1]).squaredNorm();
+    count += e.size();
+  }
+  if (count < 3 || var <= 0) return 0.0;
+  return std::clamp(1.0 - diff / (2.0 * var), 0.0, 0.9);
+}
+
 VerticalSelection SelectVertical(const Trajectory& keyframes, const std::vector<VpRay>& rays,
                                  const Eigen::Vector3d& up_world, double max_angle_deg,
                                  double outlier_deg, double min_sigma_deg) {
@@ -201,6 +228,7 @@ VerticalSelection SelectVertical(const Trajectory& keyframes, const std::vector<
   const Eigen::Matrix<double, 3, 2> tangent = TangentBasis(d);
   std::vector<Eigen::Vector2d> e;
   for (const size_t row : kept) e.push_back(tangent.transpose() * best.at(row).second);
+  for (const auto& x : e) out.errors_deg.push_back(x * kDegPerRad);
   if (e.size() >= 3) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero(), var = Eigen::Vector2d::Zero(),
                     diff = Eigen::Vector2d::Zero();
@@ -216,6 +244,41 @@ VerticalSelection SelectVertical(const Trajectory& keyframes, const std::vector<
     out.inflation = std::sqrt((1.0 + out.rho) / (1.0 - out.rho));
   }
   out.sigma_deg = std::max(min_sigma_deg, UpperMedian(std::move(angles)) / 1.1774) * out.inflation;
+  return out;
+}
+
+SlowError MeasureSlowError(const std::vector<int64_t>& frames,
+                           const std::vector<Eigen::Vector2d>& errors_deg, int half_window) {
+  JVL_CHECK(frames.size() == errors_deg.size(),
+            "MeasureSlowError: " << frames.size() << " frames, " << errors_deg.size() << " errors");
+  JVL_CHECK(half_window >= 0, "MeasureSlowError: half_window must be >= 0, got " << half_window);
+  JVL_CHECK(std::is_sorted(frames.begin(), frames.end()),
+            "MeasureSlowError: frames must be ascending");
+  SlowError out;
+  const size_t n = errors_deg.size();
+  if (n < 3) return out;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& x : errors_deg) mean += x;
+  mean /= static_cast<double>(n);
+  Eigen::Vector2d diff = Eigen::Vector2d::Zero();
+  for (size_t i = 1; i < n; ++i) diff += (errors_deg[i] - errors_deg[i - 1]).cwiseAbs2();
+  const Eigen::Vector2d white2 = diff / (2.0 * static_cast<double>(n - 1));
+  out.white_deg = white2.cwiseSqrt();
+  // Prefix sums over the de-meaned errors; the window of sample i holds the samples whose frame
+  // is within half_window of frames[i].
+  std::vector<Eigen::Vector2d> prefix(n + 1, Eigen::Vector2d::Zero());
+  for (size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + (errors_deg[i] - mean);
+  Eigen::Vector2d excess = Eigen::Vector2d::Zero();
+  size_t lo = 0, hi = 0;
+  for (size_t i = 0; i < n; ++i) {
+    while (frames[lo] < frames[i] - half_window) ++lo;
+    while (hi < n && frames[hi] <= frames[i] + half_window) ++hi;
+    const double count = static_cast<double>(hi - lo);
+    const Eigen::Vector2d m = (prefix[hi] - prefix[lo]) / count;
+    excess += m.cwiseAbs2() - white2 / count;
+  }
+  excess /= static_cast<double>(n);
+  out.low_frequency_deg = excess.cwiseMax(0.0).cwiseSqrt();
   return out;
 }
 

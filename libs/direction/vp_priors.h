@@ -69,6 +69,15 @@ double MedianDirectionError(const Trajectory& keyframes, const PinholeCamera& ca
 Eigen::Vector2d MedianAbsDirectionError(const Trajectory& keyframes, const PinholeCamera& camera,
                                         const std::vector<VpPrior>& priors);
 
+// Lag-1 correlation of the errors v - pi(R_nw d_w) of consecutive priors of the same cluster
+// (`clusters` as in DirectionSelection; priors in keyframe order): 1 - sum |e_i - e_{i-1}|^2 /
+// (2 sum |e_i - mean of its cluster|^2), pooled over the clusters and both image axes, clamped
+// to [0, 0.9]; 0 with fewer than 3 priors. The VPs of neighbouring keyframes come from the same
+// edges, so their errors are not independent.
+double DirectionErrorCorrelation(const Trajectory& keyframes, const PinholeCamera& camera,
+                                 const std::vector<VpPrior>& priors,
+                                 const std::vector<int32_t>& clusters);
+
 // A vanishing direction of a frame as a unit ray in its camera (vps artifact; any VP, possibly
 // at infinity in the image).
 struct VpRay {
@@ -92,7 +101,22 @@ struct VerticalSelection {
   double inflation = 1;
   int64_t candidates = 0;  // Keyframes with a VP within max_angle_deg of up.
   int64_t outliers = 0;    // Candidates outside the gate.
+  // Per row of `rows`: the angle of R_wn ray from `direction` in its tangent plane (deg, the
+  // two axes of a fixed basis).
+  std::vector<Eigen::Vector2d> errors_deg;
 };
+
+// How far a sequence of per-frame errors (deg, two axes; frames ascending) wanders slowly, beyond
+// what its frame-to-frame noise explains. Per axis, after removing the mean: `white_deg` is the
+// RMS of consecutive differences / sqrt(2) (the uncorrelated part); `low_frequency_deg` is the
+// RMS of the centred moving mean over +-half_window frames, less the share white noise leaves in
+// such a mean (white^2 / samples in the window), clamped at 0. Fewer than 3 samples: zeros.
+struct SlowError {
+  Eigen::Vector2d white_deg = Eigen::Vector2d::Zero();
+  Eigen::Vector2d low_frequency_deg = Eigen::Vector2d::Zero();
+};
+SlowError MeasureSlowError(const std::vector<int64_t>& frames,
+                           const std::vector<Eigen::Vector2d>& errors_deg, int half_window);
 
 // `up_world` is the world's up direction as the keyframes see it (e.g. minus the y axis of the
 // first camera, as direction_cluster takes it). Candidates: per keyframe the ray with the

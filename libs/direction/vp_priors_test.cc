@@ -154,5 +154,63 @@ TEST(VpPriors, SelectVerticalInflatesSigmaForCorrelatedErrors) {
   EXPECT_GT(b.inflation, 2.0 * a.inflation);
 }
 
+// White noise alone leaves no low-frequency error; a slow drift on one axis shows as about its
+// RMS on that axis, and the white part is measured from consecutive differences either way.
+TEST(VpPriors, MeasureSlowErrorSeparatesDriftFromWhiteNoise) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.2);
+  std::vector<int64_t> frames;
+  std::vector<Eigen::Vector2d> white, drift;
+  double drift_ms = 0;
+  for (int i = 0; i < 600; ++i) {
+    frames.push_back(i);
+    const Eigen::Vector2d e(noise(rng), noise(rng));
+    white.push_back(e);
+    const double slow = 0.3 * std::sin(2.0 * M_PI * i / 300.0);  // RMS 0.212 deg
+    drift_ms += slow * slow / 600.0;
+    drift.push_back(e + Eigen::Vector2d(0.0, slow));
+  }
+  const SlowError a = MeasureSlowError(frames, white, 10);
+  EXPECT_NEAR(a.white_deg.x(), 0.2, 0.02);
+  EXPECT_NEAR(a.white_deg.y(), 0.2, 0.02);
+  EXPECT_LT(a.low_frequency_deg.maxCoeff(), 0.03);
+  const SlowError b = MeasureSlowError(frames, drift, 10);
+  EXPECT_NEAR(b.white_deg.y(), 0.2, 0.02);
+  EXPECT_LT(b.low_frequency_deg.x(), 0.03);
+  EXPECT_NEAR(b.low_frequency_deg.y(), std::sqrt(drift_ms), 0.03);
+  // Gaps in the frames narrow the windows, not the result's meaning; too few samples: zeros.
+  std::vector<int64_t> sparse;
+  for (const int64_t f : frames) sparse.push_back(3 * f);
+  EXPECT_NEAR(MeasureSlowError(sparse, drift, 30).low_frequency_deg.y(), std::sqrt(drift_ms), 0.03);
+  EXPECT_EQ(MeasureSlowError({0, 1}, {drift[0], drift[1]}, 10).low_frequency_deg.maxCoeff(), 0.0);
+  EXPECT_THROW(MeasureSlowError({1, 0, 2}, {drift[0], drift[1], drift[2]}, 10), std::exception);
+  EXPECT_THROW(MeasureSlowError({0, 1}, {drift[0]}, 10), std::exception);
+}
+
+// The e_D errors of a cluster whose VPs share their error over runs of keyframes are correlated;
+// independent errors are not.
+TEST(VpPriors, DirectionErrorCorrelationSeesSharedErrors) {
+  RefitCase rc = MakeRefitCase(120, 0.0, 0.0, 5);
+  const PinholeCamera camera = KittiCamera();
+  std::mt19937 rng(6);
+  std::normal_distribution<double> noise(0.0, 2.0);
+  DirectionSelection independent = rc.selection, shared = rc.selection;
+  Eigen::Vector2d run = Eigen::Vector2d::Zero();
+  for (size_t i = 0; i < rc.selection.priors.size(); ++i) {
+    const Eigen::Vector2d e(noise(rng), noise(rng));
+    independent.priors[i].vp += e;
+    if (i % 6 == 0) run = e;
+    shared.priors[i].vp += run;
+  }
+  const double a =
+      DirectionErrorCorrelation(rc.keyframes, camera, independent.priors, independent.clusters);
+  const double b = DirectionErrorCorrelation(rc.keyframes, camera, shared.priors, shared.clusters);
+  EXPECT_LT(a, 0.3);
+  EXPECT_GT(b, 0.6);
+  EXPECT_LE(b, 0.9);
+  EXPECT_EQ(DirectionErrorCorrelation(rc.keyframes, camera, {}, {}), 0.0);
+  EXPECT_THROW(DirectionErrorCorrelation(rc.keyframes, camera, shared.priors, {}), std::exception);
+}
+
 }  // namespace
 }  // namespace jvl::direction

@@ -95,6 +95,10 @@ void GlobalMappingOptions::Check() const {
                 min_direction_sigma_px > 0,
             "direction_sigma_px must be finite and min_direction_sigma_px > 0");
   JVL_CHECK(std::isfinite(odometry_gate), "odometry_gate must be finite");
+  JVL_CHECK(std::isfinite(vertical_bias_deg) && std::isfinite(vertical_sigma_deg),
+            "vertical_bias_deg and vertical_sigma_deg must be finite");
+  JVL_CHECK(vertical_half_window >= 0,
+            "vertical_half_window must be >= 0 frames, got " << vertical_half_window);
   JVL_CHECK(std::isfinite(min_odometry_sigma_m) && min_odometry_sigma_m > 0 &&
                 std::isfinite(min_odometry_sigma_deg) && min_odometry_sigma_deg > 0,
             "the minimum odometry sigmas must be positive");
@@ -276,6 +280,7 @@ struct FixedTerms {
 struct DirectionTerm {
   bool entered = false;
   std::vector<direction::VpPrior> priors;  // d_w as it was when e_D entered
+  std::vector<int32_t> clusters;           // cluster of each prior
   std::vector<optim::DirectionConstraint> constraints;
   std::vector<Eigen::Vector3d> free_directions;  // kFree: current d_w of each kept cluster
   int vertical_block = -1;  // index of the vertical prior's direction in free_directions
@@ -450,12 +455,14 @@ void EnterDirections(const Trajectory& keyframes, const PinholeCamera& camera,
   term->entered = true;
   if (options.direction_source == Source::kPrior) {
     term->priors = dirs.priors;
+    term->clusters = dirs.clusters;
     term->constraints = ToDirectionConstraints(term->priors);
     return;
   }
   const direction::DirectionRefit refit = direction::RefitDirections(
       keyframes, camera, dirs, options.refit_outlier_deg, options.refit_min_support);
   term->priors = refit.selection.priors;
+  term->clusters = refit.selection.clusters;
   term->constraints = ToDirectionConstraints(term->priors);
   result->directions_outliers = refit.outliers;
   result->directions_small_cluster = refit.small_cluster_vps;
@@ -495,10 +502,34 @@ void EnterVertical(const std::vector<direction::VpRay>& rays, const GlobalMappin
         v.rows.size(), v.candidates, options.refit_min_support);
     return;
   }
+  std::vector<int64_t> frames;
+  for (const int64_t row : v.rows) frames.push_back(result->keyframes.frames[row]);
+  const direction::SlowError slow =
+      direction::MeasureSlowError(frames, v.errors_deg, options.vertical_half_window);
+  result->vertical_disagreement_deg = slow.low_frequency_deg.maxCoeff();
+  result->vertical_white_deg = slow.white_deg.maxCoeff();
+  result->vertical_rho = v.rho;
+  const double d = result->vertical_disagreement_deg, b = options.vertical_bias_deg;
+  if (options.vertical_sigma_deg > 0) {
+    result->vertical_sigma_deg = options.vertical_sigma_deg;
+  } else if (b > 0) {
+    if (d <= b) {
+      result->vertical_no_evidence = true;
+      spdlog::info(
+          "vertical direction prior: left out, its VPs disagree with the poses by {:.3f} deg at "
+          "low frequency, within their own slow bias of {:.3f} deg (no evidence of tilt; {} "
+          "keyframes, white spread {:.3f} deg)",
+          d, b, v.rows.size(), result->vertical_white_deg);
+      return;
+    }
+    result->vertical_sigma_deg =
+        std::max(options.min_vertical_sigma_deg, b * d / std::sqrt(d * d - b * b));
+  } else {
+    result->vertical_sigma_deg = v.sigma_deg;
+  }
   result->vertical_used = static_cast<int64_t>(v.rows.size());
-  result->vertical_sigma_deg = v.sigma_deg;
   result->vertical_direction = v.direction;
-  joint->direction_sigma_rad = v.sigma_deg / kDegPerRad;
+  joint->direction_sigma_rad = result->vertical_sigma_deg / kDegPerRad;
   term->vertical_block = static_cast<int>(term->free_directions.size());
   term->free_directions.push_back(v.direction);
   for (size_t i = 0; i < v.rows.size(); ++i) {
@@ -509,11 +540,12 @@ void EnterVertical(const std::vector<direction::VpRay>& rays, const GlobalMappin
     c.free_direction = term->vertical_block;
     term->constraints.push_back(c);
   }
-  result->vertical_rho = v.rho;
   spdlog::info(
-      "vertical direction prior: {} keyframes ({} candidates, {} outliers), sigma "
-      "{:.3f} deg (lag-1 correlation {:.2f}, inflation {:.2f})",
-      v.rows.size(), v.candidates, v.outliers, v.sigma_deg, v.rho, v.inflation);
+      "vertical direction prior: {} keyframes ({} candidates, {} outliers), sigma {:.3f} deg "
+      "(low-frequency disagreement {:.3f} deg, bias {:.3f} deg; white spread {:.3f} deg, lag-1 "
+      "correlation {:.2f})",
+      v.rows.size(), v.candidates, v.outliers, result->vertical_sigma_deg, d, b,
+      result->vertical_white_deg, v.rho);
 }
 
 // sigma of e_D: given, or estimated where e_D enters from the median |e_D| (2D Gaussian: median
@@ -526,8 +558,13 @@ void SetDirectionSigma(const Trajectory& keyframes, const PinholeCamera& camera,
     result->direction_sigma_px = options.direction_sigma_px;
     return;
   }
+  // The VPs of neighbouring keyframes share their edges: the AR(1) effective-sample-size
+  // inflation sqrt((1 + rho) / (1 - rho)) of the lag-1 correlation within the clusters.
+  result->direction_rho =
+      direction::DirectionErrorCorrelation(keyframes, camera, term.priors, term.clusters);
+  const double inflation = std::sqrt((1.0 + result->direction_rho) / (1.0 - result->direction_rho));
   const auto at_least_min = [&](double sigma) {
-    return std::isfinite(sigma) ? std::max(options.min_direction_sigma_px, sigma) : 1.0;
+    return std::isfinite(sigma) ? std::max(options.min_direction_sigma_px, sigma) * inflation : 1.0;
   };
   result->direction_sigma_estimated = true;
   if (options.direction_sigma_per_axis) {
@@ -535,14 +572,15 @@ void SetDirectionSigma(const Trajectory& keyframes, const PinholeCamera& camera,
     const Eigen::Vector2d mad = direction::MedianAbsDirectionError(keyframes, camera, term.priors);
     result->direction_sigma_px = at_least_min(mad.x() * kMadToSigma);
     result->direction_sigma_v_px = at_least_min(mad.y() * kMadToSigma);
-    spdlog::debug("e_D sigma estimated: u {:.3f} px, v {:.3f} px", result->direction_sigma_px,
-                  result->direction_sigma_v_px);
+    spdlog::info("e_D sigma estimated: u {:.3f} px, v {:.3f} px (lag-1 correlation {:.2f})",
+                 result->direction_sigma_px, result->direction_sigma_v_px, result->direction_rho);
     return;
   }
   const double sigma =
       direction::MedianDirectionError(keyframes, camera, term.priors) / std::sqrt(2.0 * M_LN2);
   result->direction_sigma_px = at_least_min(sigma);
-  spdlog::debug("e_D sigma estimated: {:.3f} px", result->direction_sigma_px);
+  spdlog::info("e_D sigma estimated: {:.3f} px (lag-1 correlation {:.2f})",
+               result->direction_sigma_px, result->direction_rho);
 }
 
 // e_D (Eq. 6) of this round: left out before GlobalMappingOptions::first_direction_round.
@@ -777,6 +815,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
         {"sigma_px", r.direction_sigma_px},
         {"sigma_v_px", r.direction_sigma_v_px > 0 ? r.direction_sigma_v_px : r.direction_sigma_px},
         {"sigma_estimated", r.direction_sigma_estimated},
+        {"rho", r.direction_rho},
         {"outliers", r.directions_outliers},
         {"small_cluster", r.directions_small_cluster},
         {"change_deg", ChangeJson(r.direction_change_deg)},
@@ -788,6 +827,11 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
         {"outliers", r.vertical_outliers},
         {"sigma_deg", r.vertical_sigma_deg},
         {"rho", r.vertical_rho},
+        {"disagreement_deg", r.vertical_disagreement_deg},
+        {"white_deg", r.vertical_white_deg},
+        {"bias_deg", o.vertical_bias_deg},
+        {"half_window", o.vertical_half_window},
+        {"no_evidence", r.vertical_no_evidence},
         {"direction",
          r.vertical_used > 0 ? VectorJson(r.vertical_direction) : nlohmann::json(nullptr)}}},
       {"odometry",

@@ -93,8 +93,10 @@ struct GlobalMappingOptions {
   int refit_min_support = 3;       // clusters with fewer inlier keyframes are left out
   // sigma of e_D in pixels (its whitening, see JointProblemOptions::direction_sigma_px).
   // <= 0: estimated when e_D enters the problem from the median of |v - pi(R_nw d_w)| at the
-  // current poses / sqrt(2 ln 2) (2D Gaussian), at least min_direction_sigma_px. The weight
-  // rule then balances whitened residuals.
+  // current poses / sqrt(2 ln 2) (2D Gaussian), at least min_direction_sigma_px, times the AR(1)
+  // inflation sqrt((1 + rho) / (1 - rho)) of the errors' lag-1 correlation rho within the
+  // clusters (direction::DirectionErrorCorrelation). The weight rule then balances whitened
+  // residuals.
   double direction_sigma_px = 0.0;
   double min_direction_sigma_px = 0.5;
   // Estimated sigma per image axis: sigma_u and sigma_v from the medians of |u error| and
@@ -109,6 +111,17 @@ struct GlobalMappingOptions {
   double vertical_max_deg = 10.0;     // candidates: VPs within this of the world's up
   double vertical_outlier_deg = 1.0;  // smallest gate of the robust mean
   double min_vertical_sigma_deg = 0.05;
+  // The vertical prior's weight from the evidence that the solution tilts (docs/global_opt.md
+  // "Vertical direction prior"): D = the low-frequency disagreement between the vertical VPs
+  // and the poses where e_D enters (direction::MeasureSlowError over +-vertical_half_window
+  // frames; the larger tangent axis). The VPs are themselves slowly biased by up to about
+  // vertical_bias_deg (B); where D <= B they show no tilt of the solution and the prior is left
+  // out, otherwise its sigma is B D / sqrt(D^2 - B^2) (at least min_vertical_sigma_deg): from
+  // off at D = B down to B where D >> B. vertical_bias_deg <= 0: sigma from the VPs' spread.
+  double vertical_bias_deg = 0.1;
+  int vertical_half_window = 10;
+  // > 0: the vertical prior's sigma (deg) as given (neither rule above).
+  double vertical_sigma_deg = 0.0;
   // Odometry term e_O (beyond the paper, docs/global_opt.md "Odometry term"): from the round
   // after the first on, the motion of GlobalMapInput::odometry between consecutive keyframes
   // (optim::RelativePoseCost), whitened by its noise per axis as measured against the first
@@ -148,10 +161,16 @@ struct GlobalMappingResult {
   std::vector<Eigen::Vector3d> free_directions;  // kFree: optimised d_w per kept cluster
   std::vector<int32_t> free_direction_clusters;  // cluster id of each free_directions entry
   bool direction_sigma_estimated = false;
+  // Estimated sigma: the lag-1 correlation of e_D within the clusters it was inflated for.
+  double direction_rho = 0;
   // The vertical direction prior: keyframes with a candidate, inliers used, outliers, the
   // measured sigma (deg) and the optimised direction (NaN when not used).
   int64_t vertical_candidates = 0, vertical_used = 0, vertical_outliers = 0;
   double vertical_sigma_deg = 0, vertical_rho = 0;
+  // Its low-frequency disagreement with the poses where e_D enters (deg, larger axis), the
+  // white part of its spread, and whether the evidence rule left it out (D <= bias).
+  double vertical_disagreement_deg = 0, vertical_white_deg = 0;
+  bool vertical_no_evidence = false;
   // The odometry term: keyframe pairs, the measured per-frame sigmas, and the pairs whose
   // whitened residual ended above the kernel scale (down-weighted: the odometry's steps).
   int64_t odometry_pairs = 0, odometry_gated = 0, odometry_outliers = 0;

@@ -189,8 +189,10 @@ TEST(GlobalMapping, DirectionPriorsRemoveAYawDriftTheOtherTermsCannot) {
 }
 
 // Physically consistent world (true scans and keypoints, prior drifting 0.1 deg of yaw per
-// keyframe): the local terms see most of the drift, the direction priors remove the rest.
-// Default options (free d_w, sigma estimated).
+// keyframe): the local terms see most of the drift, the direction priors remove part of the
+// rest. Default options (free d_w, sigma estimated): the drift left at the warm-started poses is
+// a slow error of e_D, so the estimated sigma is inflated as for correlated VP errors
+// (direction_rho) and e_D removes less than with the VP noise given (the test above).
 TEST(GlobalMapping, DirectionPriorsImproveOnAConsistentDriftingSequence) {
   SyntheticGlobalOptions so;
   so.keyframes = 60;
@@ -199,7 +201,8 @@ TEST(GlobalMapping, DirectionPriorsImproveOnAConsistentDriftingSequence) {
   const auto f = RunAblation(so);
   EXPECT_LT(f.with.translation_m, 0.3 * f.prior.translation_m);
   EXPECT_LT(f.with.rotation_deg, 0.3 * f.prior.rotation_deg);
-  EXPECT_LT(f.with.translation_m, 0.85 * f.without.translation_m);
+  EXPECT_LT(f.with.translation_m, 0.95 * f.without.translation_m);
+  EXPECT_GT(f.result_with.direction_rho, 0.5);
   EXPECT_EQ(f.result_with.rounds, 2);
   EXPECT_TRUE(f.result_with.direction_sigma_estimated);
   ASSERT_EQ(f.result_with.free_directions.size(), 1u);
