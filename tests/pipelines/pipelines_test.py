@@ -21,6 +21,7 @@ JOBS_PY = os.path.join(ROOT, "pipelines", "jobs.py")
 COLLECT_PY = os.path.join(ROOT, "pipelines", "collect.py")
 GAINS_PY = os.path.join(ROOT, "pipelines", "gains_table.py")
 FIDELITY_PY = os.path.join(ROOT, "scripts", "sim_fidelity.py")
+SLOW_BIAS_PY = os.path.join(ROOT, "scripts", "vp_slow_bias.py")
 
 
 def run(args, **kwargs):
@@ -378,6 +379,59 @@ class SimFidelity(unittest.TestCase):
         self.assertEqual(out.returncode, 1)
         out = run([sys.executable, FIDELITY_PY])
         self.assertEqual(out.returncode, 2)
+
+
+class VpSlowBias(unittest.TestCase):
+    """scripts/vp_slow_bias.py on hand-made vertical VPs: white noise, and a slow wander on one
+    axis on top of it."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp()
+        # Identity poses: the camera's up is -y.
+        self.poses = os.path.join(self.dir, "poses.txt")
+        with open(self.poses, "w") as f:
+            for _ in range(600):
+                f.write("1 0 0 0 0 1 0 0 0 0 1 0\n")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def vps(self, name, slow_deg):
+        import random
+        rng = random.Random(7)
+        path = os.path.join(self.dir, name)
+        with open(path, "w") as f:
+            f.write("frame,vp_index,u,v,dx,dy,dz,inliers,residual_deg,score,is_forward\n")
+            for k in range(600):
+                ex = math.radians(rng.gauss(0.0, 0.2) + slow_deg * math.sin(2 * math.pi * k / 300))
+                ez = math.radians(rng.gauss(0.0, 0.2))
+                f.write(f"{k},0,0,0,0,0.02,1,50,0.5,100,1\n")  # a forward VP: not vertical
+                f.write(f"{k},1,0,0,{ex},{-1.0},{ez},50,0.5,100,0\n")
+        return path
+
+    def slow_bias(self, vps):
+        out = run([sys.executable, SLOW_BIAS_PY, vps, self.poses])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertTrue(out.stdout.startswith("600 vertical VPs"), out.stdout)
+        return float(out.stdout.split("slow bias ")[1].split()[0])
+
+    def test_white_noise_and_a_slow_wander(self):
+        self.assertLess(self.slow_bias(self.vps("white.csv", 0.0)), 0.03)
+        # A sine of amplitude 0.3 deg has an RMS of 0.212 deg.
+        self.assertAlmostEqual(self.slow_bias(self.vps("slow.csv", 0.3)), 0.212, delta=0.03)
+
+    def test_bad_input(self):
+        out = run([sys.executable, SLOW_BIAS_PY, self.poses, self.poses])
+        self.assertEqual(out.returncode, 1)
+        self.assertIn("not a vp_detect CSV", out.stderr)
+        short = os.path.join(self.dir, "short.txt")
+        with open(short, "w") as f:
+            f.write("1 0 0 0 0 1 0 0 0 0 1 0\n")
+        out = run([sys.executable, SLOW_BIAS_PY, self.vps("v.csv", 0.0), short])
+        self.assertEqual(out.returncode, 1)
+        self.assertIn("has no pose", out.stderr)
+        out = run([sys.executable, SLOW_BIAS_PY, self.poses])
+        self.assertEqual(out.returncode, 1)
 
 
 if __name__ == "__main__":
