@@ -9,12 +9,13 @@ up (within --max-deg, 10, of minus the first camera's y axis) is taken into the 
 true rotation; the errors are its angles from their mean direction on two tangent axes. The
 statistic is global_opt's (direction::MeasureSlowError): per axis, the white spread (RMS of
 consecutive differences / sqrt 2) and the low-frequency error, the RMS of the centred moving
-mean over +-FRAMES frames (default 10) less the share white noise leaves in such a mean. The
-larger axis's low-frequency error is what global_opt's --vertical-bias stands for: how far the
-VPs wander from the truth from stretch to stretch of the drive.
+mean over +-FRAMES frames (default 10) less the share white noise leaves in such a mean; the
+slow bias is the same along the direction it is largest in (largest eigenvalue of the 2 x 2
+covariance). The slow bias is what global_opt's --vertical-bias stands for: how far the VPs
+wander from the truth from stretch to stretch of the drive.
 
-Prints one line: the drive's VP count, both axes' white and low-frequency errors (deg), and the
-larger low-frequency error.
+Prints one line: the drive's VP count, both axes' white and low-frequency errors and the slow
+bias (deg).
 """
 import csv
 import math
@@ -76,29 +77,36 @@ def vertical_vps(path, rotations, max_deg):
 
 
 def slow_error(frames, errors, half_window):
-    """(white, low_frequency) per axis, as direction::MeasureSlowError."""
+    """(white per axis, low frequency per axis, slow) as direction::MeasureSlowError."""
     n = len(errors)
-    white, low = [0.0, 0.0], [0.0, 0.0]
     if n < 3:
-        return white, low
-    for a in range(2):
-        x = [e[a] for e in errors]
-        mean = sum(x) / n
-        x = [v - mean for v in x]
-        white2 = sum((x[i] - x[i - 1]) ** 2 for i in range(1, n)) / (2.0 * (n - 1))
-        excess = 0.0
-        lo = hi = 0
-        for i in range(n):
-            while frames[lo] < frames[i] - half_window:
-                lo += 1
-            while hi < n and frames[hi] <= frames[i] + half_window:
-                hi += 1
-            count = hi - lo
-            m = sum(x[lo:hi]) / count
-            excess += m * m - white2 / count
-        white[a] = math.sqrt(white2)
-        low[a] = math.sqrt(max(0.0, excess / n))
-    return white, low
+        return [0.0, 0.0], [0.0, 0.0], 0.0
+    mean = [sum(e[a] for e in errors) / n for a in range(2)]
+    x = [[e[a] - mean[a] for a in range(2)] for e in errors]
+    w = [[0.0, 0.0], [0.0, 0.0]]  # white covariance
+    for i in range(1, n):
+        d = [x[i][a] - x[i - 1][a] for a in range(2)]
+        for a in range(2):
+            for b in range(2):
+                w[a][b] += d[a] * d[b] / (2.0 * (n - 1))
+    c = [[0.0, 0.0], [0.0, 0.0]]  # slow covariance
+    lo = hi = 0
+    for i in range(n):
+        while frames[lo] < frames[i] - half_window:
+            lo += 1
+        while hi < n and frames[hi] <= frames[i] + half_window:
+            hi += 1
+        count = hi - lo
+        m = [sum(x[k][a] for k in range(lo, hi)) / count for a in range(2)]
+        for a in range(2):
+            for b in range(2):
+                c[a][b] += (m[a] * m[b] - w[a][b] * (1.0 / count - 1.0 / n)) / n
+    # Largest eigenvalue of the symmetric 2 x 2 matrix c.
+    half_trace = 0.5 * (c[0][0] + c[1][1])
+    largest = half_trace + math.sqrt(max(0.0, (0.5 * (c[0][0] - c[1][1])) ** 2 + c[0][1] ** 2))
+    white = [math.sqrt(w[a][a]) for a in range(2)]
+    low = [math.sqrt(max(0.0, c[a][a])) for a in range(2)]
+    return white, low, math.sqrt(max(0.0, largest))
 
 
 def main(argv):
@@ -133,10 +141,10 @@ def main(argv):
     b1 = unit(cross(mean, helper))
     b2 = cross(mean, b1)
     errors = [(math.degrees(dot(best[f], b1)), math.degrees(dot(best[f], b2))) for f in frames]
-    white, low = slow_error(frames, errors, half_window)
+    white, low, slow = slow_error(frames, errors, half_window)
     print(
         f"{len(frames)} vertical VPs: white {white[0]:.3f} / {white[1]:.3f} deg, low-frequency "
-        f"(+-{half_window} frames) {low[0]:.3f} / {low[1]:.3f} deg; slow bias {max(low):.3f} deg"
+        f"(+-{half_window} frames) {low[0]:.3f} / {low[1]:.3f} deg; slow bias {slow:.3f} deg"
     )
     return 0
 

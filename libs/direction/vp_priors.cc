@@ -1,5 +1,6 @@
 #include "direction/vp_priors.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -163,15 +164,19 @@ double DirectionErrorCorrelation(const Trajectory& keyframes, const PinholeCamer
   JVL_CHECK(priors.size() == clusters.size(),
             "DirectionErrorCorrelation: " << priors.size() << " priors, " << clusters.size()
                                           << " cluster ids");
-  // Errors per cluster in the priors' order (directions parallel to the image plane skipped).
-  std::map<int32_t, std::vector<Eigen::Vector2d>> by_cluster;
+  // Errors per cluster in keyframe order (directions parallel to the image plane skipped).
+  std::map<int32_t, std::vector<std::pair<int64_t, Eigen::Vector2d>>> by_cluster;
   for (size_t i = 0; i < priors.size(); ++i) {
     const auto e = DirectionErrors(keyframes, camera, {priors[i]});
-    if (!e.empty()) by_cluster[clusters[i]].push_back(e.front());
+    if (!e.empty()) by_cluster[clusters[i]].emplace_back(priors[i].keyframe, e.front());
   }
   double var = 0, diff = 0;
   size_t count = 0;
-  for (const auto& [cluster, e] : by_cluster) {
+  for (auto& [cluster, keyed] : by_cluster) {
+    std::stable_sort(keyed.begin(), keyed.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<Eigen::Vector2d> e;
+    for (const auto& k : keyed) e.push_back(k.second);
     if (e.size() < 2) continue;
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (const auto& x : e) mean += x;
@@ -260,25 +265,30 @@ SlowError MeasureSlowError(const std::vector<int64_t>& frames,
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (const auto& x : errors_deg) mean += x;
   mean /= static_cast<double>(n);
-  Eigen::Vector2d diff = Eigen::Vector2d::Zero();
-  for (size_t i = 1; i < n; ++i) diff += (errors_deg[i] - errors_deg[i - 1]).cwiseAbs2();
-  const Eigen::Vector2d white2 = diff / (2.0 * static_cast<double>(n - 1));
-  out.white_deg = white2.cwiseSqrt();
+  Eigen::Matrix2d white = Eigen::Matrix2d::Zero();
+  for (size_t i = 1; i < n; ++i) {
+    const Eigen::Vector2d d = errors_deg[i] - errors_deg[i - 1];
+    white += d * d.transpose();
+  }
+  white /= 2.0 * static_cast<double>(n - 1);
+  out.white_deg = white.diagonal().cwiseSqrt();
   // Prefix sums over the de-meaned errors; the window of sample i holds the samples whose frame
   // is within half_window of frames[i].
   std::vector<Eigen::Vector2d> prefix(n + 1, Eigen::Vector2d::Zero());
   for (size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + (errors_deg[i] - mean);
-  Eigen::Vector2d excess = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d slow = Eigen::Matrix2d::Zero();
   size_t lo = 0, hi = 0;
   for (size_t i = 0; i < n; ++i) {
     while (frames[lo] < frames[i] - half_window) ++lo;
     while (hi < n && frames[hi] <= frames[i] + half_window) ++hi;
     const double count = static_cast<double>(hi - lo);
     const Eigen::Vector2d m = (prefix[hi] - prefix[lo]) / count;
-    excess += m.cwiseAbs2() - white2 / count;
+    slow += m * m.transpose() - white * (1.0 / count - 1.0 / static_cast<double>(n));
   }
-  excess /= static_cast<double>(n);
-  out.low_frequency_deg = excess.cwiseMax(0.0).cwiseSqrt();
+  slow /= static_cast<double>(n);
+  out.low_frequency_deg = slow.diagonal().cwiseMax(0.0).cwiseSqrt();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(slow);
+  out.slow_deg = std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
   return out;
 }
 

@@ -70,10 +70,10 @@ Eigen::Vector2d MedianAbsDirectionError(const Trajectory& keyframes, const Pinho
                                         const std::vector<VpPrior>& priors);
 
 // Lag-1 correlation of the errors v - pi(R_nw d_w) of consecutive priors of the same cluster
-// (`clusters` as in DirectionSelection; priors in keyframe order): 1 - sum |e_i - e_{i-1}|^2 /
-// (2 sum |e_i - mean of its cluster|^2), pooled over the clusters and both image axes, clamped
-// to [0, 0.9]; 0 with fewer than 3 priors. The VPs of neighbouring keyframes come from the same
-// edges, so their errors are not independent.
+// (`clusters` as in DirectionSelection; consecutive in keyframe order, whatever the gap): 1 - sum
+// |e_i - e_{i-1}|^2 / (2 sum |e_i - mean of its cluster|^2), pooled over the clusters and both
+// image axes, clamped to [0, 0.9]; 0 with fewer than 3 priors. The VPs of neighbouring keyframes
+// come from the same edges, so their errors are not independent.
 double DirectionErrorCorrelation(const Trajectory& keyframes, const PinholeCamera& camera,
                                  const std::vector<VpPrior>& priors,
                                  const std::vector<int32_t>& clusters);
@@ -107,13 +107,17 @@ struct VerticalSelection {
 };
 
 // How far a sequence of per-frame errors (deg, two axes; frames ascending) wanders slowly, beyond
-// what its frame-to-frame noise explains. Per axis, after removing the mean: `white_deg` is the
-// RMS of consecutive differences / sqrt(2) (the uncorrelated part); `low_frequency_deg` is the
-// RMS of the centred moving mean over +-half_window frames, less the share white noise leaves in
-// such a mean (white^2 / samples in the window), clamped at 0. Fewer than 3 samples: zeros.
+// what its frame-to-frame noise explains. After removing the mean: the white covariance W is
+// sum (e_i - e_{i-1})(e_i - e_{i-1})^T / (2 (n - 1)) (the uncorrelated part); m_i is the centred
+// moving mean over the samples within +-half_window frames of sample i (count c_i); the slow
+// covariance is mean_i (m_i m_i^T - W (1 / c_i - 1 / n)), white noise's share in such a mean of
+// de-meaned samples taken out. `low_frequency_deg` is the square root of its diagonal (per
+// axis, clamped at 0) and `slow_deg` of its largest eigenvalue: the slow error along the
+// direction it is largest in, whatever the axes. Fewer than 3 samples: zeros.
 struct SlowError {
   Eigen::Vector2d white_deg = Eigen::Vector2d::Zero();
   Eigen::Vector2d low_frequency_deg = Eigen::Vector2d::Zero();
+  double slow_deg = 0;
 };
 SlowError MeasureSlowError(const std::vector<int64_t>& frames,
                            const std::vector<Eigen::Vector2d>& errors_deg, int half_window);

@@ -178,13 +178,40 @@ TEST(VpPriors, MeasureSlowErrorSeparatesDriftFromWhiteNoise) {
   EXPECT_NEAR(b.white_deg.y(), 0.2, 0.02);
   EXPECT_LT(b.low_frequency_deg.x(), 0.03);
   EXPECT_NEAR(b.low_frequency_deg.y(), std::sqrt(drift_ms), 0.03);
-  // Gaps in the frames narrow the windows, not the result's meaning; too few samples: zeros.
+  EXPECT_NEAR(b.slow_deg, std::sqrt(drift_ms), 0.03);
+  // Every third frame: the same samples in a window three times as wide.
   std::vector<int64_t> sparse;
   for (const int64_t f : frames) sparse.push_back(3 * f);
   EXPECT_NEAR(MeasureSlowError(sparse, drift, 30).low_frequency_deg.y(), std::sqrt(drift_ms), 0.03);
+  // Too few samples: zeros.
   EXPECT_EQ(MeasureSlowError({0, 1}, {drift[0], drift[1]}, 10).low_frequency_deg.maxCoeff(), 0.0);
   EXPECT_THROW(MeasureSlowError({1, 0, 2}, {drift[0], drift[1], drift[2]}, 10), std::exception);
   EXPECT_THROW(MeasureSlowError({0, 1}, {drift[0]}, 10), std::exception);
+}
+
+// Exact values on a short ramp (n = 20, one frame per sample): the white covariance is half the
+// squared step, and a window of one sample (half_window 0) leaves the ramp's variance less
+// white^2 (1 - 1/n); a window over the whole series leaves nothing (its mean is removed). The
+// slow error along a ramp at 45 deg is the same as along an axis (per axis it is 1/sqrt 2 of it).
+TEST(VpPriors, MeasureSlowErrorOnARampIsExactAndRotationInvariant) {
+  const int n = 20;
+  std::vector<int64_t> frames;
+  std::vector<Eigen::Vector2d> along_x, diagonal;
+  for (int i = 0; i < n; ++i) {
+    frames.push_back(i);
+    along_x.emplace_back(0.01 * i, 0.0);
+    diagonal.emplace_back(0.01 * i / std::sqrt(2.0), 0.01 * i / std::sqrt(2.0));
+  }
+  // Ramp variance (n^2 - 1) / 12 steps^2 = 33.25e-4; white^2 = 0.5e-4.
+  const double expected = std::sqrt(33.25e-4 - 0.5e-4 * (1.0 - 1.0 / n));
+  const SlowError a = MeasureSlowError(frames, along_x, 0);
+  EXPECT_NEAR(a.white_deg.x(), std::sqrt(0.5e-4), 1e-12);
+  EXPECT_NEAR(a.low_frequency_deg.x(), expected, 1e-12);
+  EXPECT_NEAR(a.slow_deg, expected, 1e-12);
+  const SlowError d = MeasureSlowError(frames, diagonal, 0);
+  EXPECT_NEAR(d.slow_deg, expected, 1e-12);
+  EXPECT_NEAR(d.low_frequency_deg.x(), expected / std::sqrt(2.0), 1e-6);
+  EXPECT_NEAR(MeasureSlowError(frames, along_x, n).slow_deg, 0.0, 1e-12);
 }
 
 // The e_D errors of a cluster whose VPs share their error over runs of keyframes are correlated;

@@ -48,11 +48,11 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
   method.Add("--vertical-bias", o->vertical_bias_deg,
              "Vertical prior: the slow bias of the vertical VPs (deg). Left out where they "
              "disagree with the poses by no more than this at low frequency, weighted by the "
-             "excess otherwise (<= 0: sigma from the VPs' spread)");
+             "excess otherwise (0: sigma from the VPs' spread)");
   method.Add("--vertical-window", o->vertical_half_window,
              "Vertical prior: half window (frames) of the low-frequency disagreement");
   method.Add("--vertical-sigma", o->vertical_sigma_deg,
-             "Vertical prior: its sigma in degrees as given (> 0 overrides --vertical-bias)");
+             "Vertical prior: its sigma in degrees as given (0: from --vertical-bias)");
   method.Flag("!--no-odometry", o->use_odometry,
               "Leave out the odometry term e_O (the paper's energy; ablation)");
   method.Add("--odometry-gate", o->odometry_gate,

@@ -95,8 +95,13 @@ void GlobalMappingOptions::Check() const {
                 min_direction_sigma_px > 0,
             "direction_sigma_px must be finite and min_direction_sigma_px > 0");
   JVL_CHECK(std::isfinite(odometry_gate), "odometry_gate must be finite");
-  JVL_CHECK(std::isfinite(vertical_bias_deg) && std::isfinite(vertical_sigma_deg),
-            "vertical_bias_deg and vertical_sigma_deg must be finite");
+  JVL_CHECK(
+      std::isfinite(vertical_bias_deg) && vertical_bias_deg >= 0,
+      "vertical_bias_deg must be >= 0 (0: sigma from the VPs' spread), got " << vertical_bias_deg);
+  JVL_CHECK(std::isfinite(vertical_sigma_deg) && vertical_sigma_deg >= 0,
+            "vertical_sigma_deg must be >= 0 (0: from the rule), got " << vertical_sigma_deg);
+  JVL_CHECK(std::isfinite(min_vertical_sigma_deg) && min_vertical_sigma_deg > 0,
+            "min_vertical_sigma_deg must be > 0, got " << min_vertical_sigma_deg);
   JVL_CHECK(vertical_half_window >= 0,
             "vertical_half_window must be >= 0 frames, got " << vertical_half_window);
   JVL_CHECK(std::isfinite(min_odometry_sigma_m) && min_odometry_sigma_m > 0 &&
@@ -506,15 +511,17 @@ void EnterVertical(const std::vector<direction::VpRay>& rays, const GlobalMappin
   for (const int64_t row : v.rows) frames.push_back(result->keyframes.frames[row]);
   const direction::SlowError slow =
       direction::MeasureSlowError(frames, v.errors_deg, options.vertical_half_window);
-  result->vertical_disagreement_deg = slow.low_frequency_deg.maxCoeff();
+  result->vertical_disagreement_deg = slow.slow_deg;
   result->vertical_white_deg = slow.white_deg.maxCoeff();
   result->vertical_rho = v.rho;
   const double d = result->vertical_disagreement_deg, b = options.vertical_bias_deg;
   if (options.vertical_sigma_deg > 0) {
+    result->vertical_sigma_rule = "given";
     result->vertical_sigma_deg = options.vertical_sigma_deg;
-  } else if (b > 0) {
-    if (d <= b) {
-      result->vertical_no_evidence = true;
+  } else if (b > 0 && v.rows.size() >= 3) {
+    // Left out also where D exceeds B by a rounding error (sigma would be infinite).
+    if (d <= b * (1.0 + 1e-9)) {
+      result->vertical_sigma_rule = "left_out";
       spdlog::info(
           "vertical direction prior: left out, its VPs disagree with the poses by {:.3f} deg at "
           "low frequency, within their own slow bias of {:.3f} deg (no evidence of tilt; {} "
@@ -522,9 +529,16 @@ void EnterVertical(const std::vector<direction::VpRay>& rays, const GlobalMappin
           d, b, v.rows.size(), result->vertical_white_deg);
       return;
     }
+    result->vertical_sigma_rule = "evidence";
     result->vertical_sigma_deg =
-        std::max(options.min_vertical_sigma_deg, b * d / std::sqrt(d * d - b * b));
+        std::max(options.min_vertical_sigma_deg, b * d / std::sqrt((d - b) * (d + b)));
   } else {
+    if (b > 0)
+      spdlog::info(
+          "vertical direction prior: {} keyframes are too few to measure the low-frequency "
+          "disagreement; sigma from the VPs' spread",
+          v.rows.size());
+    result->vertical_sigma_rule = "spread";
     result->vertical_sigma_deg = v.sigma_deg;
   }
   result->vertical_used = static_cast<int64_t>(v.rows.size());
@@ -564,7 +578,8 @@ void SetDirectionSigma(const Trajectory& keyframes, const PinholeCamera& camera,
       direction::DirectionErrorCorrelation(keyframes, camera, term.priors, term.clusters);
   const double inflation = std::sqrt((1.0 + result->direction_rho) / (1.0 - result->direction_rho));
   const auto at_least_min = [&](double sigma) {
-    return std::isfinite(sigma) ? std::max(options.min_direction_sigma_px, sigma) * inflation : 1.0;
+    return (std::isfinite(sigma) ? std::max(options.min_direction_sigma_px, sigma) : 1.0) *
+           inflation;
   };
   result->direction_sigma_estimated = true;
   if (options.direction_sigma_per_axis) {
@@ -831,7 +846,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
         {"white_deg", r.vertical_white_deg},
         {"bias_deg", o.vertical_bias_deg},
         {"half_window", o.vertical_half_window},
-        {"no_evidence", r.vertical_no_evidence},
+        {"sigma_rule", r.vertical_sigma_rule},
         {"direction",
          r.vertical_used > 0 ? VectorJson(r.vertical_direction) : nlohmann::json(nullptr)}}},
       {"odometry",

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 #include "direction/vp_priors.h"
@@ -105,8 +106,8 @@ struct GlobalMappingOptions {
   bool direction_sigma_per_axis = false;
   // Vertical direction prior (beyond the paper): with e_D, one free world direction shared by
   // the vertical VPs of every keyframe (direction::SelectVertical at the poses where e_D enters),
-  // as ray-form e_D residuals whitened by their measured spread (at least min_vertical_sigma_deg)
-  // and weighted by gamma like e_D. It ties roll and pitch along the whole drive.
+  // as ray-form e_D residuals whitened by the sigma of the rule below and weighted by gamma like
+  // e_D. It ties roll and pitch along the whole drive.
   bool use_vertical = true;
   double vertical_max_deg = 10.0;     // candidates: VPs within this of the world's up
   double vertical_outlier_deg = 1.0;  // smallest gate of the robust mean
@@ -114,10 +115,12 @@ struct GlobalMappingOptions {
   // The vertical prior's weight from the evidence that the solution tilts (docs/global_opt.md
   // "Vertical direction prior"): D = the low-frequency disagreement between the vertical VPs
   // and the poses where e_D enters (direction::MeasureSlowError over +-vertical_half_window
-  // frames; the larger tangent axis). The VPs are themselves slowly biased by up to about
-  // vertical_bias_deg (B); where D <= B they show no tilt of the solution and the prior is left
-  // out, otherwise its sigma is B D / sqrt(D^2 - B^2) (at least min_vertical_sigma_deg): from
-  // off at D = B down to B where D >> B. vertical_bias_deg <= 0: sigma from the VPs' spread.
+  // frames: its slow_deg, along the direction the slow error is largest in). The VPs are themselves
+  // slowly biased by up to about vertical_bias_deg (B); where D <= B they show no tilt of the
+  // solution and the prior is left out, otherwise its sigma is B D / sqrt(D^2 - B^2) (at least
+  // min_vertical_sigma_deg): from off at D = B down to B where D >> B. vertical_bias_deg = 0, or
+  // fewer than 3 keyframes: sigma from the VPs' spread (SelectVertical's AR(1)-inflated median
+  // angle).
   double vertical_bias_deg = 0.1;
   int vertical_half_window = 10;
   // > 0: the vertical prior's sigma (deg) as given (neither rule above).
@@ -163,14 +166,16 @@ struct GlobalMappingResult {
   bool direction_sigma_estimated = false;
   // Estimated sigma: the lag-1 correlation of e_D within the clusters it was inflated for.
   double direction_rho = 0;
-  // The vertical direction prior: keyframes with a candidate, inliers used, outliers, the
-  // measured sigma (deg) and the optimised direction (NaN when not used).
+  // The vertical direction prior: keyframes with a candidate, inliers used, outliers, the sigma
+  // used (deg; 0 when left out), which rule gave it ("given", "evidence", "spread", "left_out";
+  // empty when the prior never entered), the lag-1 correlation of its errors and the optimised
+  // direction (NaN when not used).
   int64_t vertical_candidates = 0, vertical_used = 0, vertical_outliers = 0;
   double vertical_sigma_deg = 0, vertical_rho = 0;
-  // Its low-frequency disagreement with the poses where e_D enters (deg, larger axis), the
-  // white part of its spread, and whether the evidence rule left it out (D <= bias).
+  std::string vertical_sigma_rule;
+  // Its low-frequency disagreement with the poses where e_D enters (deg, SlowError::slow_deg)
+  // and the white part of its spread (deg, larger axis).
   double vertical_disagreement_deg = 0, vertical_white_deg = 0;
-  bool vertical_no_evidence = false;
   // The odometry term: keyframe pairs, the measured per-frame sigmas, and the pairs whose
   // whitened residual ended above the kernel scale (down-weighted: the odometry's steps).
   int64_t odometry_pairs = 0, odometry_gated = 0, odometry_outliers = 0;
