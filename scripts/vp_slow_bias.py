@@ -14,8 +14,8 @@ slow bias is the same along the direction it is largest in (largest eigenvalue o
 covariance). The slow bias is what global_opt's --vertical-bias stands for: how far the VPs
 wander from the truth from stretch to stretch of the drive.
 
-Prints one line: the drive's VP count, both axes' white and low-frequency errors and the slow
-bias (deg).
+Prints one line: the drive's VP count, both axes' white and low-frequency errors, the slow
+bias (deg) and its ratio to the larger white spread (global_opt's --vertical-bias-per-white).
 """
 import csv
 import math
@@ -144,7 +144,8 @@ def main(argv):
     white, low, slow = slow_error(frames, errors, half_window)
     print(
         f"{len(frames)} vertical VPs: white {white[0]:.3f} / {white[1]:.3f} deg, low-frequency "
-        f"(+-{half_window} frames) {low[0]:.3f} / {low[1]:.3f} deg; slow bias {slow:.3f} deg"
+        f"(+-{half_window} frames) {low[0]:.3f} / {low[1]:.3f} deg; slow bias {slow:.3f} deg "
+        f"({slow / max(white) if max(white) > 0 else 0.0:.2f} of the larger white spread)"
     )
     return 0
 

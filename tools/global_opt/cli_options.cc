@@ -49,6 +49,8 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
              "Vertical prior: the slow bias of the vertical VPs (deg). Left out where they "
              "disagree with the poses by no more than this at low frequency, weighted by the "
              "excess otherwise (0: sigma from the VPs' spread)");
+  method.Add("--vertical-bias-per-white", o->vertical_bias_per_white,
+             "Vertical prior: the slow bias is at least this share of the VPs' white spread");
   method.Add("--vertical-window", o->vertical_half_window,
              "Vertical prior: half window (frames) of the low-frequency disagreement");
   method.Add("--vertical-sigma", o->vertical_sigma_deg,

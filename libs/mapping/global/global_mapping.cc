@@ -98,6 +98,8 @@ void GlobalMappingOptions::Check() const {
   JVL_CHECK(
       std::isfinite(vertical_bias_deg) && vertical_bias_deg >= 0,
       "vertical_bias_deg must be >= 0 (0: sigma from the VPs' spread), got " << vertical_bias_deg);
+  JVL_CHECK(std::isfinite(vertical_bias_per_white) && vertical_bias_per_white >= 0,
+            "vertical_bias_per_white must be >= 0, got " << vertical_bias_per_white);
   JVL_CHECK(std::isfinite(vertical_sigma_deg) && vertical_sigma_deg >= 0,
             "vertical_sigma_deg must be >= 0 (0: from the rule), got " << vertical_sigma_deg);
   JVL_CHECK(std::isfinite(min_vertical_sigma_deg) && min_vertical_sigma_deg > 0,
@@ -514,7 +516,14 @@ void EnterVertical(const std::vector<direction::VpRay>& rays, const GlobalMappin
   result->vertical_disagreement_deg = slow.slow_deg;
   result->vertical_white_deg = slow.white_deg.maxCoeff();
   result->vertical_rho = v.rho;
-  const double d = result->vertical_disagreement_deg, b = options.vertical_bias_deg;
+  // The slow bias is at least a share of the white spread (noisier VPs are also more slowly
+  // biased); 0 keeps the spread rule.
+  const double b = options.vertical_bias_deg > 0
+                       ? std::max(options.vertical_bias_deg,
+                                  options.vertical_bias_per_white * result->vertical_white_deg)
+                       : 0.0;
+  result->vertical_bias_deg = b;
+  const double d = result->vertical_disagreement_deg;
   if (options.vertical_sigma_deg > 0) {
     result->vertical_sigma_rule = "given";
     result->vertical_sigma_deg = options.vertical_sigma_deg;
@@ -844,7 +853,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
         {"rho", r.vertical_rho},
         {"disagreement_deg", r.vertical_disagreement_deg},
         {"white_deg", r.vertical_white_deg},
-        {"bias_deg", o.vertical_bias_deg},
+        {"bias_deg", r.vertical_bias_deg},
         {"half_window", o.vertical_half_window},
         {"sigma_rule", r.vertical_sigma_rule},
         {"direction",

@@ -122,6 +122,10 @@ struct GlobalMappingOptions {
   // fewer than 3 keyframes: sigma from the VPs' spread (SelectVertical's AR(1)-inflated median
   // angle).
   double vertical_bias_deg = 0.1;
+  // B is at least this share of the VPs' white spread (SlowError::white_deg, larger axis):
+  // noisier VPs are more slowly biased too (slow / white on the drives measured: 0.36-1.0, real
+  // KITTI 04 0.41; docs/global_opt.md).
+  double vertical_bias_per_white = 0.35;
   int vertical_half_window = 10;
   // > 0: the vertical prior's sigma (deg) as given (neither rule above).
   double vertical_sigma_deg = 0.0;
@@ -176,6 +180,7 @@ struct GlobalMappingResult {
   // Its low-frequency disagreement with the poses where e_D enters (deg, SlowError::slow_deg)
   // and the white part of its spread (deg, larger axis).
   double vertical_disagreement_deg = 0, vertical_white_deg = 0;
+  double vertical_bias_deg = 0;  // the slow bias B used (0: spread rule)
   // The odometry term: keyframe pairs, the measured per-frame sigmas, and the pairs whose
   // whitened residual ended above the kernel scale (down-weighted: the odometry's steps).
   int64_t odometry_pairs = 0, odometry_gated = 0, odometry_outliers = 0;
