@@ -23,7 +23,9 @@ import os
 import sys
 
 
-def read_poses(path):
+def read_poses(path, min_poses=3):
+    """[(rotation rows, translation)] of a KITTI pose file; ValueError if malformed or shorter
+    than min_poses."""
     poses = []
     with open(path) as f:
         for line_no, line in enumerate(f, 1):
@@ -34,8 +36,8 @@ def read_poses(path):
                 raise ValueError(f"{path}:{line_no}: expected 12 numbers, found {len(v)}")
             x = [float(t) for t in v]
             poses.append(([x[0:3], x[4:7], x[8:11]], [x[3], x[7], x[11]]))
-    if len(poses) < 3:
-        raise ValueError(f"{path}: {len(poses)} poses, at least 3 needed")
+    if len(poses) < min_poses:
+        raise ValueError(f"{path}: {len(poses)} poses, at least {min_poses} needed")
     return poses
 
 

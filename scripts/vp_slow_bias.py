@@ -21,21 +21,7 @@ import csv
 import math
 import sys
 
-
-def read_poses(path):
-    rotations = []
-    with open(path) as f:
-        for line_no, line in enumerate(f, 1):
-            v = line.split()
-            if not v:
-                continue
-            if len(v) != 12:
-                raise ValueError(f"{path}:{line_no}: expected 12 numbers, found {len(v)}")
-            x = [float(t) for t in v]
-            rotations.append([x[0:3], x[4:7], x[8:11]])
-    if not rotations:
-        raise ValueError(f"{path}: no poses")
-    return rotations
+from sim_fidelity import read_poses
 
 
 def unit(v):
@@ -131,7 +117,7 @@ def main(argv):
         i += 1
     if len(files) != 2:
         raise ValueError("expected VPS.csv and POSES.txt (see --help)")
-    rotations = read_poses(files[1])
+    rotations = [rotation for rotation, _ in read_poses(files[1], min_poses=1)]
     best = vertical_vps(files[0], rotations, max_deg)
     if len(best) < 3:
         raise ValueError(f"{files[0]}: {len(best)} frames with a vertical VP, at least 3 needed")
