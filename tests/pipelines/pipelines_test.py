@@ -22,6 +22,7 @@ COLLECT_PY = os.path.join(ROOT, "pipelines", "collect.py")
 GAINS_PY = os.path.join(ROOT, "pipelines", "gains_table.py")
 FIDELITY_PY = os.path.join(ROOT, "scripts", "sim_fidelity.py")
 SLOW_BIAS_PY = os.path.join(ROOT, "scripts", "vp_slow_bias.py")
+SENSOR_FIDELITY_PY = os.path.join(ROOT, "scripts", "sensor_fidelity.py")
 
 
 def run(args, **kwargs):
@@ -432,6 +433,64 @@ class VpSlowBias(unittest.TestCase):
         self.assertIn("has no pose", out.stderr)
         out = run([sys.executable, SLOW_BIAS_PY, self.poses])
         self.assertEqual(out.returncode, 1)
+
+
+class SensorFidelity(unittest.TestCase):
+    """scripts/sensor_fidelity.py on hand-made sensor_stats artifacts: the band around the
+    reference, the absolute floor for fractions, missing statistics and bad input."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp()
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def stats(self, name, scan, image=None):
+        path = os.path.join(self.dir, name)
+        part = lambda d: {k: {"median": v, "p10": v, "p90": v, "frames": [v]} for k, v in d.items()}
+        with open(path, "w") as f:
+            json.dump({"schema": "sensor_stats", "schema_version": 1, "provenance": {},
+                       "frames": [0], "scan": part(scan),
+                       "image": part(image) if image is not None else None}, f)
+        return path
+
+    def test_band_and_fraction_floor(self):
+        real = self.stats("real.json", {"points": 1000, "ground": 0.5, "range_80_up": 0.001,
+                                        "scattered": 0.4}, {"fast_corners": 4000})
+        sim = self.stats("sim.json", {"points": 1250, "ground": 0.7, "range_80_up": 0.02,
+                                      "scattered": None}, {"fast_corners": 700})
+        md = os.path.join(self.dir, "t.md")
+        out = run([sys.executable, SENSOR_FIDELITY_PY, "--markdown", md, "real=" + real,
+                   "sim=" + sim])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        rows = {line.split("|")[1].strip(): [c.strip() for c in line.split("|")[2:-1]]
+                for line in out.stdout.splitlines()[2:]}
+        self.assertEqual(rows["scan points"], ["1000", "1250"])         # +25 %: inside +-30 %
+        self.assertEqual(rows["scan ground"], ["0.500", "0.700 !"])     # +40 % and 0.2 away
+        self.assertEqual(rows["scan range_80_up"], ["0.001", "0.020"])  # 20x, but 0.019 away
+        self.assertEqual(rows["scan scattered"], ["0.400", "-"])        # not measured
+        self.assertEqual(rows["image fast_corners"], ["4000", "700.0 !"])
+        self.assertEqual(rows["outside the band"], ["(reference)", "2"])
+        self.assertEqual(read(md), out.stdout)
+        out = run([sys.executable, SENSOR_FIDELITY_PY, "--band", "0.5", "real=" + real,
+                   "sim=" + sim])
+        self.assertIn("| scan ground | 0.500 | 0.700 |", out.stdout)
+
+    def test_bad_input(self):
+        real = self.stats("real.json", {"points": 1000})
+        other = os.path.join(self.dir, "other.json")
+        with open(other, "w") as f:
+            json.dump({"schema": "metrics"}, f)
+        out = run([sys.executable, SENSOR_FIDELITY_PY, "real=" + real, "x=" + other])
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("not a sensor_stats artifact", out.stderr)
+        out = run([sys.executable, SENSOR_FIDELITY_PY, "real=" + real, "x=" + other + ".none"])
+        self.assertEqual(out.returncode, 2)
+        out = run([sys.executable, SENSOR_FIDELITY_PY, "real=" + real])
+        self.assertEqual(out.returncode, 2)
+        out = run([sys.executable, SENSOR_FIDELITY_PY, real, real])
+        self.assertEqual(out.returncode, 2)
+        self.assertIn("expected NAME=STATS.json", out.stderr)
 
 
 if __name__ == "__main__":

@@ -219,7 +219,7 @@ class BadInputTest : public ::testing::Test {
 std::string BadInputTest::id_;
 
 TEST_F(BadInputTest, MissingAndDamagedDatasetFiles) {
-  for (const std::string tool : {"dataset_info", "lidar_odom", "vp_detect"}) {
+  for (const std::string tool : {"dataset_info", "lidar_odom", "vp_detect", "sensor_stats"}) {
     const std::string out = tool == "dataset_info" ? "" : " -o " + Bad("x.h5");
     ExpectError(tool, "--dataset " + Bad("no_such_folder") + out, "no_such_folder: dataset folder");
   }
@@ -544,6 +544,11 @@ TEST_F(BadInputTest, InvalidOptions) {
   ExpectError("dataset_info", "-d " + kSeq + " --frames 9:3", "--frames: end must be");
   ExpectError("dataset_info", "-d " + kSeq + " --format kitti-odometry", "--format: unknown");
   ExpectError("dataset_info", "-d " + kSeq + " --no-such-option", "--no-such-option");
+  ExpectError("sensor_stats", "-d " + kSeq + " -o " + Bad("s.json") + " --every 0", "--every");
+  ExpectError("sensor_stats", "-d " + kSeq + " -o " + Bad("s.json") + " --no-scans --no-images",
+              "--no-scans and --no-images leave nothing");
+  ExpectError("sensor_stats", "-d " + kSeq + " -o " + Bad("s.json") + " --shape-radius 0",
+              "voxel_size and radius must be > 0");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --sequence 1x",
               "--sequence must be two digits");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --frames 100000", "--frames 100000 exceeds");
