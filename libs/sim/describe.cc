@@ -116,6 +116,8 @@ nlohmann::json DescribeScene(const World& world) {
                  {"blur_sigma", cam.blur_sigma},
                  {"supersample", cam.supersample},
                  {"supersample_contrast", cam.supersample_contrast}};
+  j["vegetation"] = {{"foliage_density", sc.options.foliage_density},
+                     {"hedge_coverage", sc.options.HedgeCoverage()}};
   j["terrain"] = {{"scale", sc.options.terrain_scale},
                   {"amplitude", sc.terrain.amplitude},
                   {"wavelength", sc.terrain.wavelength},

@@ -188,6 +188,34 @@ void PlacePlants(Scene& scene, Rng& rng) {
   }
 }
 
+// Hedge rows along both sides of the road, beyond the sidewalk: runs of U(15, 60) m, each a
+// chain of bushes 1.2 m apart (radius U(0.9, 1.4) m, so they merge into one row of leaf
+// clumps), separated by gaps whose mean length makes `coverage` the covered fraction of each
+// side. Buildings and the road are kept clear.
+void PlaceHedges(Scene& scene, double coverage, Rng& rng) {
+  if (coverage <= 0) return;
+  const double clear = scene.options.road_half_width + scene.options.sidewalk_width;
+  const double mean_run = 37.5;
+  const double mean_gap = coverage >= 1 ? 0.0 : mean_run * (1 - coverage) / coverage;
+  const double length = scene.route.length();
+  for (double side : {-1.0, 1.0}) {
+    double s = rng.Uniform(0, mean_gap + 5);
+    while (s < length) {
+      const double run = rng.Uniform(15, 60);
+      const double offset = rng.Uniform(0.5, 1.5);
+      for (double t = s; t < std::min(s + run, length); t += 1.2) {
+        const RoadPoint rp = scene.route.At(t);
+        const double r = rng.Uniform(0.9, 1.4);
+        const Eigen::Vector2d p = rp.position + side * Normal(rp.heading) * (clear + offset + r);
+        if (scene.route.Distance(p) < clear + r || InsideAnyBuilding(scene, p, r + 0.5)) continue;
+        const double z = scene.terrain.Height(p.x(), p.y());
+        scene.plants.push_back({Eigen::Vector3d(p.x(), p.y(), z + 0.7 * r), r, false});
+      }
+      s += run + (mean_gap > 0 ? rng.Uniform(0, 2 * mean_gap) : 0.0);
+    }
+  }
+}
+
 void PlaceMovingCars(Scene& scene, Rng& rng) {
   const double len = scene.route.length();
   for (int i = 0; i < scene.options.moving_cars; ++i) {
@@ -235,10 +263,16 @@ std::array<Eigen::Vector2d, 4> Building::Corners() const {
 }
 
 void SceneOptions::Check() const {
-  JVL_CHECK(road_half_width > 3.5, "road_half_width must exceed one lane (3.5 m), got " << road_half_width);
+  JVL_CHECK(road_half_width > 3.5,
+            "road_half_width must exceed one lane (3.5 m), got " << road_half_width);
   JVL_CHECK(sidewalk_width >= 0, "sidewalk_width must be >= 0, got " << sidewalk_width);
-  JVL_CHECK(ground_cell > 0.2 && ground_cell <= 10, "ground_cell must be in (0.2, 10] m, got " << ground_cell);
+  JVL_CHECK(ground_cell > 0.2 && ground_cell <= 10,
+            "ground_cell must be in (0.2, 10] m, got " << ground_cell);
   JVL_CHECK(moving_cars >= 0, "moving_cars must be >= 0, got " << moving_cars);
+  JVL_CHECK(std::isnan(hedge_coverage) || (hedge_coverage >= 0 && hedge_coverage <= 1),
+            "hedge_coverage must be in [0, 1], got " << hedge_coverage);
+  JVL_CHECK(std::isfinite(foliage_density) && foliage_density >= 0 && foliage_density <= 5,
+            "foliage_density must be in [0, 5] m^2/m^3, got " << foliage_density);
   JVL_CHECK(std::isfinite(terrain_scale) && terrain_scale >= 0 && terrain_scale <= 5,
             "terrain_scale must be in [0, 5], got " << terrain_scale);
 }
@@ -261,6 +295,11 @@ Box Scene::MovingCarBox(size_t i, double t) const {
   return box;
 }
 
+double SceneOptions::HedgeCoverage() const {
+  if (!std::isnan(hedge_coverage)) return hedge_coverage;
+  return IsHighwayLike(scenario) ? kHighwayHedgeCoverage : 0.0;
+}
+
 Scene BuildScene(const Route& route, const SceneOptions& options) {
   options.Check();
   Scene scene;
@@ -274,6 +313,8 @@ Scene BuildScene(const Route& route, const SceneOptions& options) {
   AssignAxisGroups(scene);
   PlaceStreetFurniture(scene, rng);
   PlacePlants(scene, rng);
+  Rng hedge_rng(HashCombine(options.seed, 0x4ed9e));  // Its own stream: the rest is unchanged.
+  PlaceHedges(scene, options.HedgeCoverage(), hedge_rng);
   PlaceMovingCars(scene, rng);
   BuildSceneMesh(scene, rng);
   return scene;

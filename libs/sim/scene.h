@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,10 @@ struct MovingCar {
   Eigen::Vector3d size{4.3, 1.8, 1.5};
 };
 
+// Hedge coverage of the highway-like scenarios' roadsides (docs/sim.md "Fidelity table": set
+// from the real KITTI 04 scans' ground and scattered fractions); other scenarios have none.
+inline constexpr double kHighwayHedgeCoverage = 0.7;
+
 struct SceneOptions {
   Scenario scenario = Scenario::kUrban;
   uint64_t seed = 1;
@@ -101,6 +106,14 @@ struct SceneOptions {
   int moving_cars = 4;
   // Multiplies the terrain amplitudes (0 = flat ground; slopes scale with it).
   double terrain_scale = 1.0;
+  // Leaf area density of crowns and bushes (m^2 of leaf clumps per m^3): they are volumes of
+  // small clumps that rays pass through (mean free path 2 / density). 0: each is one opaque
+  // irregular surface.
+  double foliage_density = 1.0;
+  // Fraction of each roadside lined by hedge rows beyond the sidewalk; NaN: the scenario's
+  // (HedgeCoverage()).
+  double hedge_coverage = std::numeric_limits<double>::quiet_NaN();
+  double HedgeCoverage() const;
   void Check() const;
 };
 

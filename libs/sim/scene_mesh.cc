@@ -80,8 +80,8 @@ void AddPrism(Mesh& mesh, const Eigen::Vector3d& base, double radius, double hei
   }
 }
 
-// An irregular blob: a once-subdivided icosahedron with random radial displacement, so that the
-// LiDAR odometry sees vegetation-like clutter without planar structure.
+// An irregular blob: a once-subdivided icosahedron with random radial displacement: a crown as
+// one opaque surface (foliage_density 0).
 void AddBlob(Mesh& mesh, const Eigen::Vector3d& c, double radius, Rng& rng) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<Eigen::Vector3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
@@ -120,6 +120,46 @@ void AddBlob(Mesh& mesh, const Eigen::Vector3d& c, double radius, Rng& rng) {
     mesh.AddVertex(c + q);
   }
   for (const auto& tri : g) mesh.AddTriangle(first + tri[0], first + tri[1], first + tri[2], fi);
+}
+
+// A crown (or bush) as a volume of leaf clumps: small triangles of random orientation spread
+// uniformly through an irregular ellipsoid (semi-axes radius x U(0.85, 1.15) horizontally and
+// 0.8 radius vertically), one face each. `density` is the one-sided clump area per unit volume
+// (m^2/m^3, the leaf area density of forestry); with randomly oriented clumps a ray is stopped
+// after a free path of mean 1 / (0.5 density) (Beer-Lambert, mean projection 1/2), so LiDAR
+// returns spread through the crown and the camera sees sky and background through its gaps.
+// Clumps deeper inside are darker (a stand-in for the crown's self-shadowing).
+void AddFoliage(Mesh& mesh, const Eigen::Vector3d& c, double radius, double density, float albedo,
+                Rng& rng) {
+  const Eigen::Vector3d axes(radius * rng.Uniform(0.85, 1.15), radius * rng.Uniform(0.85, 1.15),
+                             0.8 * radius);
+  const double volume = 4.0 / 3.0 * kPi * axes.x() * axes.y() * axes.z();
+  constexpr double kMeanArea = 0.037;  // Mean clump area (m^2): circumradius 0.12-0.22 m.
+  const int count = static_cast<int>(std::lround(density * volume / kMeanArea));
+  for (int k = 0; k < count; ++k) {
+    Eigen::Vector3d q;
+    do {
+      q = Eigen::Vector3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1));
+    } while (q.squaredNorm() > 1.0);
+    const double depth = q.norm();  // 0 at the centre, 1 on the surface.
+    Face face;
+    face.material = Material::kFoliage;
+    face.albedo = static_cast<float>(albedo * (0.45 + 0.55 * depth) * rng.Uniform(0.8, 1.2));
+    const uint32_t fi = mesh.AddFace(face);
+    // A random plane through the clump's centre; three corners at irregular angles.
+    Eigen::Vector3d n(rng.Normal(), rng.Normal(), rng.Normal());
+    n.normalize();
+    const Eigen::Vector3d a = n.unitOrthogonal(), b = n.cross(a);
+    const Eigen::Vector3d centre = c + q.cwiseProduct(axes);
+    const double r = rng.Uniform(0.12, 0.22);
+    const double phase = rng.Uniform(0, 2 * kPi);
+    uint32_t v[3];
+    for (int i = 0; i < 3; ++i) {
+      const double angle = phase + 2 * kPi * i / 3 + rng.Uniform(-0.4, 0.4);
+      v[i] = mesh.AddVertex(centre + r * (std::cos(angle) * a + std::sin(angle) * b));
+    }
+    mesh.AddTriangle(v[0], v[1], v[2], fi);
+  }
 }
 
 }  // namespace
@@ -188,7 +228,13 @@ void BuildSceneMesh(Scene& scene, Rng& rng) {
       AddPrism(mesh, Eigen::Vector3d(p.center.x(), p.center.y(), ground - 0.2), 0.18,
                p.center.z() - ground, Material::kTrunk, 0.35f);
     }
-    AddBlob(mesh, p.center, p.radius, rng);
+    if (scene.options.foliage_density > 0) {
+      Rng leaves(rng.Next());  // One stream per plant: its clumps do not shift the others.
+      AddFoliage(mesh, p.center, p.radius, scene.options.foliage_density,
+                 static_cast<float>(leaves.Uniform(0.3, 0.5)), leaves);
+    } else {
+      AddBlob(mesh, p.center, p.radius, rng);
+    }
   }
 }
 

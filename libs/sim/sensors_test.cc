@@ -5,6 +5,9 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "sim/raycaster.h"
+#include "sim/road.h"
+#include "sim/scene.h"
 #include "sim/scene_mesh.h"
 #include "sim/sequence.h"
 #include "sim/shading.h"
@@ -326,6 +329,66 @@ TEST(LidarTest, MotionDistortionShiftsColumnsByTheMotion) {
       const double expected = distort ? 20.0 + az / (2 * M_PI) : 20.0;
       EXPECT_NEAR(p.x(), expected, 2e-3) << "az " << az;
       if (std::abs(p.x() - expected) > 2e-3) break;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace jvl::sim
+
+namespace jvl::sim {
+namespace {
+
+// A tree crown is a volume of leaf clumps: horizontal rays aimed within half a radius of an
+// isolated crown's centre stop at every depth inside it, and some pass through. With
+// --foliage-density 0 the crown is one opaque surface: every ray stops at its shell.
+TEST(SceneTest, CrownsAreVolumesThatRaysEnterAndPassThrough) {
+  for (double density : {1.0, 0.0}) {
+    SceneOptions so;
+    so.scenario = Scenario::kHighway;
+    so.seed = 3;
+    so.foliage_density = density;
+    so.hedge_coverage = 0;
+    const Scene scene =
+        BuildScene(Route(ScenarioRoute(so.scenario), Eigen::Vector2d::Zero(), 0.0), so);
+    const Plant* tree = nullptr;
+    for (const Plant& p : scene.plants) {
+      bool alone = p.tree;
+      for (const Plant& q : scene.plants)
+        alone = alone && (&q == &p || (q.center - p.center).head<2>().norm() > 12);
+      if (alone) {
+        tree = &p;
+        break;
+      }
+    }
+    ASSERT_NE(tree, nullptr);
+    const RayCaster caster(scene.mesh);
+    const double r = tree->radius;
+    int passed = 0, hits = 0, deep = 0;
+    for (int k = 0; k < 400; ++k) {
+      const double a = 2 * M_PI * k / 400, offset = r * (((k * 7) % 11) / 10.0 - 0.5);
+      const Eigen::Vector3d d(-std::cos(a), -std::sin(a), 0);
+      const Eigen::Vector3d o = tree->center + Eigen::Vector3d(0, 0, 0.3) - 10 * d +
+                                offset * Eigen::Vector3d(-d.y(), d.x(), 0);
+      const Hit hit = caster.Intersect(o, d, 0, 20);
+      const bool in_crown = hit.valid() &&
+                            scene.mesh.faces[hit.face].material == Material::kFoliage &&
+                            (o + hit.t * d - tree->center).norm() < 1.5 * r;
+      if (!in_crown) {
+        ++passed;
+        continue;
+      }
+      ++hits;
+      if ((o + hit.t * d - tree->center).norm() < 0.6 * r) ++deep;
+    }
+    SCOPED_TRACE("foliage density " + std::to_string(density));
+    if (density > 0) {
+      EXPECT_GT(passed, 8);  // Chords of 4-5 m: exp(-0.5 x 4.5) ~ 10 % pass.
+      EXPECT_LT(passed, 120);
+      EXPECT_GT(deep, hits / 10);  // Stopped deep inside the crown.
+    } else {
+      EXPECT_EQ(passed, 0);
+      EXPECT_EQ(deep, 0);  // The blob's shell is at 0.65-1.3 radii.
     }
   }
 }

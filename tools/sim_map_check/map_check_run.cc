@@ -54,6 +54,12 @@ sim::SequenceOptions WorldOptionsFromScene(const nlohmann::json& scene, const st
     o.scene.moving_cars = static_cast<int>(Field(scene, "moving_cars", what).size());
     // Written since the terrain became scalable; older files have the default scale.
     o.scene.terrain_scale = Field(scene, "terrain", what).value("scale", 1.0);
+    // Written since crowns became volumes of leaf clumps; older files had opaque crowns.
+    // Written since crowns became volumes of leaf clumps and the roadsides got hedges; older
+    // files had opaque crowns and no hedges.
+    const nlohmann::json vegetation = scene.value("vegetation", nlohmann::json::object());
+    o.scene.foliage_density = vegetation.value("foliage_density", 0.0);
+    o.scene.hedge_coverage = vegetation.value("hedge_coverage", 0.0);
   } catch (const nlohmann::json::exception& e) {
     JVL_THROW(what << ": unexpected scene description: " << io::JsonErrorText(e));
   }

@@ -37,6 +37,12 @@ void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
   world.Add("--terrain-scale", o->scene.terrain_scale,
             "Scale of the rolling terrain's heights and slopes (0 = flat, 1 = slopes of a "
             "few percent)");
+  world.Add("--foliage-density", "foliage_density", o->scene.foliage_density,
+            "Leaf area density of tree crowns and bushes (m^2/m^3): volumes of leaf clumps "
+            "that LiDAR and camera rays pass through (0 = one opaque surface each)");
+  world.Add("--hedges", "hedge_coverage", o->scene.hedge_coverage,
+            "Fraction of each roadside lined by hedge rows beyond the sidewalk (default: 0.7 "
+            "on highway and straight, 0 elsewhere)");
 }
 
 }  // namespace jvl::tools
