@@ -74,12 +74,14 @@ Route::Route(std::vector<RoadPiece> pieces, const Eigen::Vector2d& start, double
     h = end.heading;
     length_ += piece.length;
     piece_ends_.push_back(length_);
-    all_pieces_.push_back(static_cast<int>(i));
+    if (!piece.repeat) all_pieces_.push_back(static_cast<int>(i));
   }
+  JVL_CHECK(!all_pieces_.empty(), "route has only repeated pieces");
   // Grid index for Project(): a cell lists the pieces whose bounding circle comes within
   // kIndexReach of some point of the cell.
   const double half_diagonal = kIndexCell * std::sqrt(0.5);
   for (size_t i = 0; i < pieces_.size(); ++i) {
+    if (pieces_[i].repeat) continue;
     const double reach = pieces_[i].length / 2 + kIndexReach + half_diagonal;
     const Eigen::Vector2d& mid = cache_[i].mid;
     const int64_t x0 = CellIndex(mid.x() - reach), x1 = CellIndex(mid.x() + reach);
@@ -216,7 +218,9 @@ Scenario ParseScenario(const std::string& name) {
   if (name == "suburban") return Scenario::kSuburban;
   if (name == "highway") return Scenario::kHighway;
   if (name == "straight") return Scenario::kStraight;
-  JVL_THROW("unknown scenario '" << name << "' (expected urban, suburban, highway or straight)");
+  if (name == "loop") return Scenario::kLoop;
+  JVL_THROW("unknown scenario '" << name
+                                 << "' (expected urban, suburban, highway, straight or loop)");
 }
 
 std::string ToString(Scenario scenario) {
@@ -229,6 +233,8 @@ std::string ToString(Scenario scenario) {
       return "highway";
     case Scenario::kStraight:
       return "straight";
+    case Scenario::kLoop:
+      return "loop";
   }
   return "?";
 }
@@ -253,14 +259,51 @@ std::vector<RoadPiece> ScenarioLap(Scenario scenario) {
               Turn(-15, 700, 20.0), Straight(200, 20.0)};
     case Scenario::kStraight:
       return {Straight(1200, 20.5)};
+    case Scenario::kLoop:
+      break;  // LoopRoute().
   }
   return {};
+}
+
+RoadPiece Repeat(RoadPiece p) {
+  p.repeat = true;
+  return p;
+}
+
+// kLoop: street A (east) to the block's south-west corner J, `laps` counter-clockwise circuits
+// of the block (W x H between centre lines, corners of radius R), back along A (west). The first
+// circuit passes J straight on from A; later ones turn left at J; the way back turns right at J.
+std::vector<RoadPiece> LoopRoute(int laps) {
+  constexpr double kA = 150, kW = 130, kH = 110, kR = 12;
+  const RoadPiece corner = Turn(90, kR, 5.0);
+  std::vector<RoadPiece> p = {Straight(kA, 10.5),
+                              Straight(kW - kR, 11.0),
+                              corner,
+                              Straight(kH - 2 * kR, 10.5),
+                              corner,
+                              Straight(kW - 2 * kR, 11.0),
+                              corner,
+                              Straight(kH - 2 * kR, 10.5)};
+  for (int lap = 1; lap < laps; ++lap) {
+    p.push_back(lap == 1 ? corner : Repeat(corner));  // Left at J: new on the second circuit.
+    p.push_back(Repeat(Straight(kW - 2 * kR, 11.0)));
+    p.push_back(Repeat(corner));
+    p.push_back(Repeat(Straight(kH - 2 * kR, 10.5)));
+    p.push_back(Repeat(corner));
+    p.push_back(Repeat(Straight(kW - 2 * kR, 11.0)));
+    p.push_back(Repeat(corner));
+    p.push_back(Repeat(Straight(kH - 2 * kR, 10.5)));
+  }
+  p.push_back(Turn(-90, kR, 5.0));  // Right at J, back onto A.
+  p.push_back(Repeat(Straight(kA - kR, 10.5)));
+  return p;
 }
 
 }  // namespace
 
 std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps) {
   JVL_CHECK(laps >= 1 && laps <= 100, "laps must be in [1, 100], got " << laps);
+  if (scenario == Scenario::kLoop) return LoopRoute(laps);
   std::vector<RoadPiece> pieces;
   for (int lap = 0; lap < laps; ++lap) {
     for (RoadPiece p : ScenarioLap(scenario)) {

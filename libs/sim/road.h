@@ -20,6 +20,10 @@ struct RoadPiece {
   double curvature = 0;  // 1/radius, positive = left turn; 0 for a straight.
   double speed = 10;     // Target speed on this piece (m/s).
   bool open = false;     // No buildings along it (open road).
+  // Retraces (part of) an earlier piece, in either direction: a later lap of a circuit, a street
+  // driven back. The world is laid out along the other pieces; Route::Project and Distance
+  // ignore it, so that a place has one arc length.
+  bool repeat = false;
   // Filled by Route: start pose and arc-length offset.
   Eigen::Vector2d start = Eigen::Vector2d::Zero();
   double start_heading = 0;
@@ -89,15 +93,19 @@ struct Terrain {
 
 // Scenario presets: route pieces, speeds and density of the world.
 // kStraight: the highway's scenery on one 1.2 km straight (the geometry direction priors are
-// made for: one road direction over the whole drive).
-enum class Scenario { kUrban, kSuburban, kHighway, kStraight };
-Scenario ParseScenario(const std::string& name);  // urban|suburban|highway|straight
+// made for: one road direction over the whole drive). kLoop: the urban scenery around a city
+// block with revisits: a 150 m street to the block, `laps` circuits of it (130 m x 110 m, four
+// left corners, 459 m each; every place revisited in the same direction) and back along the
+// street (revisited in the opposite direction).
+enum class Scenario { kUrban, kSuburban, kHighway, kStraight, kLoop };
+Scenario ParseScenario(const std::string& name);  // urban|suburban|highway|straight|loop
 std::string ToString(Scenario scenario);
 // Highway and straight: fast, open scenery (few buildings far from the road, no kerbside
 // furniture, flatter terrain).
 bool IsHighwayLike(Scenario scenario);
 // `laps` > 1 repeats the pieces; every second lap has its turns mirrored (left <-> right), so
-// that the route zigzags on without crossing itself (urban: 9 laps = 4.3 km, 4779 frames).
+// that the route zigzags on without crossing itself (urban: 9 laps = 4.3 km, 4779 frames). For
+// kLoop, `laps` is the number of circuits of the block (pieces after the first marked repeat).
 std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps = 1);
 
 struct DriveOptions {

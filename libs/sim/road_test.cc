@@ -95,6 +95,51 @@ TEST(RouteTest, StraightScenarioIsOneLongStraight) {
   for (double s = 0; s <= route.length(); s += 100) EXPECT_NEAR(route.At(s).heading, 0.35, 1e-12);
 }
 
+// The loop scenario: a street, three circuits of a block and back. Every repeated piece lies on
+// the geometry laid out before it (Distance ignores repeated pieces), the drive ends where it
+// started, and the world has every building and plant once, clear of every road.
+TEST(RouteTest, LoopRevisitsTheBlockAndTheStreet) {
+  EXPECT_EQ(ParseScenario("loop"), Scenario::kLoop);
+  EXPECT_EQ(ToString(Scenario::kLoop), "loop");
+  const Route route(ScenarioRoute(Scenario::kLoop, 3), Eigen::Vector2d(5, -3), 0.35);
+  // 150 m there, 3 x 459.4 m around the block, 150 m back (the corners at J shorten both by R
+  // and add a quarter circle each).
+  const double circuit = 2 * (130 + 110) - 8 * 12 + 2 * M_PI * 12;
+  EXPECT_NEAR(route.length(), 150 + 3 * circuit + 150, 1e-6);
+  EXPECT_LT((route.At(route.length()).position - Eigen::Vector2d(5, -3)).norm(), 1e-9);
+  double repeated = 0;
+  for (const RoadPiece& piece : route.pieces()) {
+    if (!piece.repeat) continue;
+    repeated += piece.length;
+    for (double t = 0; t <= piece.length; t += piece.length / 20)
+      EXPECT_LT(route.Distance(route.At(piece.s0 + t).position), 1e-6) << "piece at " << piece.s0;
+  }
+  // Revisited: circuits 2 and 3 but for the new left turn at J, and the street back.
+  EXPECT_NEAR(repeated, 2 * circuit - 12 * M_PI / 2 + 138, 1e-6);
+  SequenceOptions opt;
+  opt.scenario = Scenario::kLoop;
+  opt.laps = 3;
+  opt.render_images = opt.simulate_scans = false;
+  const auto world = BuildWorld(opt);
+  const Scene& scene = world->scene;
+  // A third circuit adds no world: the buildings and plants are those of two circuits.
+  opt.laps = 2;
+  const auto two = BuildWorld(opt);
+  ASSERT_EQ(two->scene.buildings.size(), scene.buildings.size());
+  for (size_t i = 0; i < scene.buildings.size(); ++i)
+    EXPECT_EQ(two->scene.buildings[i].center, scene.buildings[i].center);
+  ASSERT_EQ(two->scene.plants.size(), scene.plants.size());
+  EXPECT_LE(scene.poles.size(), two->scene.poles.size() + 2);  // Poles along the way out move.
+  ASSERT_GT(scene.buildings.size(), 20u);
+  for (const Building& b : scene.buildings)
+    for (const auto& c : b.Corners())
+      EXPECT_GT(scene.route.Distance(c),
+                scene.options.road_half_width + scene.options.sidewalk_width - 0.3);
+  for (size_t i = 0; i < scene.plants.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      EXPECT_GT((scene.plants[i].center - scene.plants[j].center).norm(), 1.0);
+}
+
 TEST(DriveTest, DefaultDemoMeetsTheBrief) {
   SequenceOptions opt;
   const auto world = BuildWorld(opt);

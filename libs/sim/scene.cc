@@ -46,6 +46,25 @@ bool InsideAnyBuilding(const Scene& scene, const Eigen::Vector2d& p, double marg
   return false;
 }
 
+// The route without its repeated pieces: their total length, and the route arc length at
+// distance u along them (u beyond the end: the route's end). Street furniture and hedges are
+// spaced along it, so the world does not depend on how often the vehicle retraces a street.
+double LaidOutLength(const Route& route) {
+  double length = 0;
+  for (const RoadPiece& p : route.pieces()) length += p.repeat ? 0.0 : p.length;
+  return length;
+}
+
+double LaidOutToRoute(const Route& route, double u) {
+  if (LaidOutLength(route) == route.length()) return u;  // Nothing repeated: the same numbers.
+  for (const RoadPiece& p : route.pieces()) {
+    if (p.repeat) continue;
+    if (u <= p.length) return p.s0 + u;
+    u -= p.length;
+  }
+  return route.length();
+}
+
 struct BuildingStyle {
   double len_lo, len_hi, depth_lo, depth_hi, setback_jitter, gap_prob, gap_lo, gap_hi;
   int floors_lo, floors_hi;
@@ -55,6 +74,7 @@ struct BuildingStyle {
 BuildingStyle StyleFor(Scenario s) {
   switch (s) {
     case Scenario::kUrban:
+    case Scenario::kLoop:
       return {12, 30, 10, 16, 1.0, 0.35, 4, 12, 3, 6, 0.0};
     case Scenario::kSuburban:
       return {8, 14, 8, 12, 3.0, 0.85, 6, 16, 1, 2, 3.0};
@@ -69,7 +89,10 @@ void PlaceBuildings(Scene& scene, Rng& rng) {
   const BuildingStyle st = StyleFor(scene.options.scenario);
   const double clear = scene.options.road_half_width + scene.options.sidewalk_width;
   for (const RoadPiece& piece : scene.route.pieces()) {
-    if (piece.open || (!piece.IsStraight() && std::abs(1.0 / piece.curvature) < 50)) continue;
+    if (piece.repeat || piece.open ||
+        (!piece.IsStraight() && std::abs(1.0 / piece.curvature) < 50)) {
+      continue;
+    }
     for (double side : {-1.0, 1.0}) {
       double s = piece.s0 + rng.Uniform(2, 6);
       const double end = piece.s0 + piece.length - 2;
@@ -130,9 +153,10 @@ void AssignAxisGroups(Scene& scene) {
 
 void PlaceStreetFurniture(Scene& scene, Rng& rng) {
   const double hw = scene.options.road_half_width;
-  const double len = scene.route.length();
+  const double len = LaidOutLength(scene.route);
   const Terrain& tr = scene.terrain;
-  for (double s = rng.Uniform(5, 15); s < len; s += rng.Uniform(25, 35)) {
+  for (double u = rng.Uniform(5, 15); u < len; u += rng.Uniform(25, 35)) {
+    const double s = LaidOutToRoute(scene.route, u);
     for (double side : {-1.0, 1.0}) {
       const RoadPoint rp = scene.route.At(s + (side > 0 ? 12 : 0));
       const Eigen::Vector2d p = rp.position + side * Normal(rp.heading) * (hw + 0.8);
@@ -141,8 +165,8 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
           {Eigen::Vector3d(p.x(), p.y(), tr.Height(p.x(), p.y())), 0.12, rng.Uniform(6.5, 8.5)});
     }
   }
-  for (double s = rng.Uniform(20, 40); s < len; s += rng.Uniform(55, 85)) {
-    const RoadPoint rp = scene.route.At(s);
+  for (double u = rng.Uniform(20, 40); u < len; u += rng.Uniform(55, 85)) {
+    const RoadPoint rp = scene.route.At(LaidOutToRoute(scene.route, u));
     const Eigen::Vector2d p = rp.position - Normal(rp.heading) * (hw + 1.2);
     if (scene.route.Distance(p) < hw + 0.8 || InsideAnyBuilding(scene, p, 0.5)) continue;
     const double z = tr.Height(p.x(), p.y());
@@ -152,7 +176,7 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
   }
   if (IsHighwayLike(scene.options.scenario)) return;
   for (const RoadPiece& piece : scene.route.pieces()) {
-    if (!piece.IsStraight() || piece.open) continue;
+    if (!piece.IsStraight() || piece.open || piece.repeat) continue;
     for (double side : {-1.0, 1.0}) {
       for (double s = piece.s0 + 15; s < piece.s0 + piece.length - 15; s += 6.5) {
         if (!rng.Bernoulli(0.45)) continue;
@@ -169,8 +193,10 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
 
 void PlacePlants(Scene& scene, Rng& rng) {
   const double hw = scene.options.road_half_width;
-  const bool green = scene.options.scenario != Scenario::kUrban;
+  const bool green =
+      scene.options.scenario != Scenario::kUrban && scene.options.scenario != Scenario::kLoop;
   for (const RoadPiece& piece : scene.route.pieces()) {
+    if (piece.repeat) continue;
     const double spacing = piece.open ? 7.0 : (green ? 14.0 : 30.0);
     for (double s = piece.s0 + rng.Uniform(0, spacing); s < piece.s0 + piece.length;
          s += rng.Uniform(0.6, 1.4) * spacing) {
@@ -197,14 +223,14 @@ void PlaceHedges(Scene& scene, double coverage, Rng& rng) {
   const double clear = scene.options.road_half_width + scene.options.sidewalk_width;
   const double mean_run = 37.5;
   const double mean_gap = coverage >= 1 ? 0.0 : mean_run * (1 - coverage) / coverage;
-  const double length = scene.route.length();
+  const double length = LaidOutLength(scene.route);
   for (double side : {-1.0, 1.0}) {
     double s = rng.Uniform(0, mean_gap + 5);
     while (s < length) {
       const double run = rng.Uniform(15, 60);
       const double offset = rng.Uniform(0.5, 1.5);
       for (double t = s; t < std::min(s + run, length); t += 1.2) {
-        const RoadPoint rp = scene.route.At(t);
+        const RoadPoint rp = scene.route.At(LaidOutToRoute(scene.route, t));
         const double r = rng.Uniform(0.9, 1.4);
         const Eigen::Vector2d p = rp.position + side * Normal(rp.heading) * (clear + offset + r);
         if (scene.route.Distance(p) < clear + r || InsideAnyBuilding(scene, p, r + 0.5)) continue;

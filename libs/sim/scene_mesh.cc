@@ -53,6 +53,7 @@ void AddKerbs(Scene& scene) {
   const double hw = scene.options.road_half_width;
   for (double s = 0; s + 2.0 <= scene.route.length(); s += 2.0) {
     const RoadPoint rp = scene.route.At(s + 1.0);
+    if (scene.route.pieces()[rp.piece].repeat) continue;
     const Eigen::Vector2d n(-std::sin(rp.heading), std::cos(rp.heading));
     for (double side : {-1.0, 1.0}) {
       const Eigen::Vector2d c = rp.position + side * n * (hw + 0.125);

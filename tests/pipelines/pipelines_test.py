@@ -23,6 +23,7 @@ GAINS_PY = os.path.join(ROOT, "pipelines", "gains_table.py")
 FIDELITY_PY = os.path.join(ROOT, "scripts", "sim_fidelity.py")
 SLOW_BIAS_PY = os.path.join(ROOT, "scripts", "vp_slow_bias.py")
 SENSOR_FIDELITY_PY = os.path.join(ROOT, "scripts", "sensor_fidelity.py")
+TOPVIEW_PY = os.path.join(ROOT, "scripts", "scene_topview.py")
 
 
 def run(args, **kwargs):
@@ -491,6 +492,36 @@ class SensorFidelity(unittest.TestCase):
         out = run([sys.executable, SENSOR_FIDELITY_PY, real, real])
         self.assertEqual(out.returncode, 2)
         self.assertIn("expected NAME=STATS.json", out.stderr)
+
+
+class SceneTopview(unittest.TestCase):
+    """scripts/scene_topview.py on a hand-made scene: a 100 m straight with a building."""
+
+    def test_png_and_bad_input(self):
+        d = tempfile.mkdtemp()
+        try:
+            scene = os.path.join(d, "scene.json")
+            with open(scene, "w") as f:
+                json.dump({"route": {"pieces": [
+                    {"start": [0, 0], "start_heading_rad": 0, "curvature": 0, "length": 100}]},
+                    "buildings": [{"center": [50, 15, 0], "yaw_rad": 0, "length": 20,
+                                   "depth": 10}],
+                    "plants": [{"center": [20, -10, 4], "radius": 2}],
+                    "poles": [{"base": [30, 8, 0]}]}, f)
+            png = os.path.join(d, "top.png")
+            out = run([sys.executable, TOPVIEW_PY, scene, png, "2"])
+            self.assertEqual(out.returncode, 0, out.stderr)
+            with open(png, "rb") as f:
+                data = f.read()
+            self.assertTrue(data.startswith(b"\x89PNG\r\n\x1a\n"))
+            width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+            self.assertEqual((width, height), (360, 160))  # (100 + 80) m x (0 + 80) m at 2 px/m
+            out = run([sys.executable, TOPVIEW_PY, os.path.join(d, "none.json"), png])
+            self.assertEqual(out.returncode, 1)
+            out = run([sys.executable, TOPVIEW_PY, scene])
+            self.assertEqual(out.returncode, 2)
+        finally:
+            shutil.rmtree(d)
 
 
 if __name__ == "__main__":

@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   cli.add_option("--frames", opt.frames, "Frames to write (0 = whole route)")
       ->capture_default_str();
   cli.add_option("--scenario", scenario,
-                 "urban, suburban, highway or straight (highway scenery, one 1.2 km straight)")
+                 "urban, suburban, highway, straight (highway scenery, one 1.2 km straight) or "
+                 "loop (urban scenery: a street, --laps circuits of a city block, back along "
+                 "the street)")
       ->capture_default_str();
   jvl::tools::AddSimSequenceFlags(tool, &opt);
   tool.FieldFlag("frames", "--frames");
