@@ -102,6 +102,7 @@ Series ScanSeries(const std::vector<ScanStats>& s) {
   add("linear", [](const ScanStats& x) { return x.linear; });
   add("scattered", [](const ScanStats& x) { return x.scattered; });
   add("sparse", [](const ScanStats& x) { return x.sparse; });
+  add("facing_forward", [](const ScanStats& x) { return x.facing_forward; });
   return out;
 }
 
@@ -169,6 +170,7 @@ ScanStats ComputeScanStats(const PointCloud& scan, const ScanStatsOptions& o) {
     s.range_fraction.fill(kNan);
     s.intensity_median = s.intensity_p90 = s.ground_fraction = kNan;
     s.vertical_planar = s.other_planar = s.linear = s.scattered = s.sparse = kNan;
+    s.facing_forward = kNan;
     return s;
   }
 
@@ -212,11 +214,13 @@ ScanStats ComputeScanStats(const PointCloud& scan, const ScanStatsOptions& o) {
   s.shape_voxels = voxels.size();
   if (voxels.empty()) {
     s.vertical_planar = s.other_planar = s.linear = s.scattered = s.sparse = kNan;
+    s.facing_forward = kNan;
     return s;
   }
   const lidar::PointGrid grid(voxels, o.radius);
   const double sin_tol = std::sin(o.normal_tolerance_deg * M_PI / 180.0);
   std::array<size_t, 5> counts{};  // vertical planar, other planar, linear, scattered, sparse
+  size_t forward = 0;
   std::vector<std::pair<double, int>> near;
   for (const auto& q : voxels) {
     grid.RadiusSearch(q, o.radius, 0, &near);
@@ -233,6 +237,7 @@ ScanStats ComputeScanStats(const PointCloud& scan, const ScanStatsOptions& o) {
       cov += d * d.transpose();
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    if (std::abs(eig.eigenvectors().col(0).x()) >= 0.5) ++forward;
     // Dimensionality features (Demantke et al. 2011) from the standard deviations along the
     // principal axes, largest first: linear, planar or scattered, whichever is largest.
     const Eigen::Vector3d l = eig.eigenvalues().cwiseMax(0.0);  // Ascending.
@@ -257,6 +262,7 @@ ScanStats ComputeScanStats(const PointCloud& scan, const ScanStatsOptions& o) {
   s.linear = counts[2] / n;
   s.scattered = counts[3] / n;
   s.sparse = counts[4] / n;
+  s.facing_forward = forward / n;
   return s;
 }
 

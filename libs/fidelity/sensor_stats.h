@@ -48,6 +48,10 @@ struct ScanStats {
   double linear = 0;           // Poles, trunks, edges, single rings on far surfaces.
   double scattered = 0;        // Volumetric: foliage, clutter.
   double sparse = 0;           // Fewer than min_neighbours neighbours.
+  // Of the same voxels: local normal (least principal axis) within 60 degrees of the sensor's x
+  // axis, |n_x| >= 0.5. On a road, surfaces that face along it: what constrains a registration
+  // along the direction of travel (facades and hedge rows parallel to the road do not).
+  double facing_forward = 0;
 };
 
 // Rings: a new ring starts where, in storage order, the azimuth crosses the seam behind the
