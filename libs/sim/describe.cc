@@ -93,7 +93,8 @@ nlohmann::json DescribeScene(const World& world) {
                   {"turns", rs.turns},
                   {"sharp_turns", rs.sharp_turns},
                   {"stop_at_s", world.options.drive.stop_at_s},
-                  {"steer_transition_m", world.options.drive.steer_transition}};
+                  {"steer_transition_m", world.options.drive.steer_transition},
+                  {"body_vibration_deg", world.options.drive.body_vibration}};
   nlohmann::json pieces = nlohmann::json::array();
   for (const RoadPiece& p : sc.route.pieces()) {
     pieces.push_back({{"type", p.IsStraight() ? "straight" : "arc"},

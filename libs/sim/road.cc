@@ -321,6 +321,8 @@ void DriveOptions::Check() const {
   JVL_CHECK(stop_duration >= 0, "stop_duration must be >= 0, got " << stop_duration);
   JVL_CHECK(std::isfinite(steer_transition) && steer_transition >= 0 && steer_transition <= 100,
             "steer_transition must be in [0, 100] m, got " << steer_transition);
+  JVL_CHECK(std::isfinite(body_vibration) && body_vibration >= 0 && body_vibration <= 2,
+            "body_vibration must be in [0, 2] deg, got " << body_vibration);
 }
 
 Drive PlanDrive(const Route& route, const DriveOptions& options) {
@@ -419,6 +421,21 @@ PathPoint SmoothedPath(const Route& route, double s, double window) {
 
 }  // namespace
 
+namespace {
+
+// A unit-RMS vibration signal at time t: four sinusoids of 0.5-2.5 Hz, frequencies and phases
+// drawn from (seed, axis).
+double Vibration(double t, uint64_t seed, int axis) {
+  double sum = 0;
+  for (int k = 0; k < 4; ++k) {
+    const double f = 0.5 + 2.0 * HashUnit(10 + axis, k, seed);
+    sum += std::sin(2 * kPi * f * t + 2 * kPi * HashUnit(20 + axis, k, seed));
+  }
+  return sum / std::sqrt(2.0);
+}
+
+}  // namespace
+
 Rigid3d VehiclePose(const Route& route, const Terrain& terrain, const Drive& drive,
                     const DriveOptions& options, double t, uint64_t seed) {
   const double s = DriveArcLength(drive, t);
@@ -437,10 +454,12 @@ Rigid3d VehiclePose(const Route& route, const Terrain& terrain, const Drive& dri
   // (~0.5 deg per m/s^2 of lateral acceleration) plus a small suspension sway.
   const Eigen::Vector2d g = terrain.Gradient(p.x(), p.y());
   const Eigen::Vector2d fwd(std::cos(yaw), std::sin(yaw)), left(-std::sin(yaw), std::cos(yaw));
-  const double pitch = -std::atan(g.dot(fwd));
   const double lat_acc = v * v * rp.curvature;
-  const double roll =
-      std::atan(g.dot(left)) + 0.0087 * lat_acc + 0.003 * std::sin(2 * kPi * s / 23.0 + 2 * phase);
+  const double vibration = options.body_vibration * kPi / 180 * std::min(1.0, v / 5.0);
+  const double pitch = -std::atan(g.dot(fwd)) + vibration * Vibration(t, seed, 0);
+  const double roll = std::atan(g.dot(left)) + 0.0087 * lat_acc +
+                      0.003 * std::sin(2 * kPi * s / 23.0 + 2 * phase) +
+                      vibration * Vibration(t, seed, 1);
   const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
                                Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
                                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());

@@ -122,6 +122,11 @@ struct DriveOptions {
   // moving LiDAR that straddles that instant is bent in a way no motion model can undo. Default
   // from the KITTI ground truth (docs/sim.md "Vehicle motion").
   double steer_transition = 6.0;
+  // RMS (deg) of the body's pitch and roll vibration on the road (each a sum of four sinusoids of
+  // 0.5-2.5 Hz with random phases and frequencies, fading out below 5 m/s). Default from the
+  // KITTI ground truth: frame-to-frame pitch and roll of 0.08-0.10 deg at the median
+  // (docs/sim.md "Vehicle motion"). 0: a body fixed to the terrain.
+  double body_vibration = 0.13;
   void Check() const;
 };
 

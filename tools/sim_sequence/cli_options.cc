@@ -7,12 +7,16 @@ namespace jvl::tools {
 void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
   app::OptionGroup route(tool, "Route");
   route.Add("--laps", "laps", o->laps,
-            "Drive the route this many times, every second lap mirrored (long sequences)");
+            "Drive the route this many times, every second lap mirrored (long sequences); "
+            "with --scenario loop: circuits of the block");
   route.Add("--seed", o->seed, "Random seed (world layout and noise)");
   route.Flag("--stop", o->stop, "Stop for a few seconds before the second corner");
   route.Add("--steer-transition", o->drive.steer_transition,
             "Arc length (m) over which the vehicle's curvature, yaw rate and body roll ramp into "
             "and out of a turn (0: they step where the road does)");
+  route.Add("--body-vibration", "body_vibration", o->drive.body_vibration,
+            "RMS (deg) of the body's pitch and roll vibration while moving (0: the body follows "
+            "the terrain)");
 
   app::OptionGroup sensors(tool, "Sensors");
   sensors.Add("--range-noise", o->lidar.range_noise, "LiDAR range noise sigma (m)");
