@@ -10,6 +10,7 @@
 #include <hdf5.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -393,13 +394,20 @@ TEST_F(BadInputTest, TruncatedAndWrongArtifacts) {
 TEST_F(BadInputTest, DamagedTrajectoryText) {
   const std::string gt = kRun + "/data/poses/00.txt";
   const std::string text = io::ReadTextFile(gt);
-  WriteFile(Bad("cut.txt"), text.substr(0, text.size() / 2 - 7));
+  // Cut after the fourth number of the line in the middle of the file.
+  const size_t start = text.rfind('\n', text.size() / 2) + 1;
+  std::istringstream middle(text.substr(start, text.find('\n', start) - start));
+  std::string cut = text.substr(0, start), token;
+  for (int k = 0; k < 4 && middle >> token; ++k) cut += (k > 0 ? " " : "") + token;
+  const auto cut_line = std::count(text.begin(), text.begin() + static_cast<long>(start), '\n') + 1;
+  WriteFile(Bad("cut.txt"), cut);
   WriteFile(Bad("nan.txt"), "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 nan 0 1 0 0 0 0 1 0\n");
   WriteFile(Bad("empty.txt"), "");
   WriteFile(Bad("scaled.txt"), "2 0 0 0 0 2 0 0 0 0 2 0\n");
   WriteFile(Bad("tum_q.txt"), "0.0 0 0 0 0 0 0 2\n");
   WriteFile(Bad("back.txt"), "5 1 0 0 0 0 1 0 0 0 0 1 0\n3 1 0 0 0 0 1 0 0 0 0 1 0\n");
-  ExpectError("make_prior", "-g " + Bad("cut.txt") + " -o " + Bad("x.h5"), "cut.txt:21: 4 columns");
+  ExpectError("make_prior", "-g " + Bad("cut.txt") + " -o " + Bad("x.h5"),
+              "cut.txt:" + std::to_string(cut_line) + ": 4 columns");
   ExpectError("make_prior", "-g " + Bad("nan.txt") + " -o " + Bad("x.h5"),
               "nan.txt:2: bad number 'nan' in column 4");
   ExpectError("evaluate", "--gt " + gt + " --est " + Bad("empty.txt"), "empty.txt: no poses found");
