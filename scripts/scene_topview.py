@@ -7,11 +7,12 @@ Usage: scripts/scene_topview.py OUT/sequences/00/sim/scene.json TOPVIEW.png [PIX
 Pure Python (writes the PNG itself); north is up, 40 m of margin around the route.
 """
 import json
-import os
 import math
 import struct
 import sys
 import zlib
+
+from sim_fidelity import write_atomic
 
 
 def write_png(path, rgb, width, height):
@@ -22,10 +23,8 @@ def write_png(path, rgb, width, height):
                 struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
 
     header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
-    with open(path + ".tmp", "wb") as f:
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw, 6))
-                + chunk(b"IEND", b""))
-    os.replace(path + ".tmp", path)
+    write_atomic(path, b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) +
+                 chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
 
 
 def route_points(pieces, step=0.5):

@@ -14,9 +14,10 @@ marked cells per drive. Exit status 0 unless the input is bad (the table is a me
 a test).
 """
 import json
-import os
 import math
 import sys
+
+from sim_fidelity import write_atomic
 
 SECTIONS = ("scan", "image")
 # Statistics whose value is a count or a length: compared by the relative band only.
@@ -130,10 +131,7 @@ def main(argv):
     text, _ = table(drives, band, floor)
     sys.stdout.write(text)
     if markdown:
-        tmp = markdown + ".tmp"
-        with open(tmp, "w") as f:
-            f.write(text)
-        os.replace(tmp, markdown)
+        write_atomic(markdown, text)
     return 0
 
 

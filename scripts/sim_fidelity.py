@@ -23,6 +23,14 @@ import os
 import sys
 
 
+def write_atomic(path, data):
+    """Writes data (str or bytes) to path through a temporary file renamed over it."""
+    tmp = path + ".tmp"
+    with open(tmp, "wb" if isinstance(data, bytes) else "w") as f:
+        f.write(data)
+    os.replace(tmp, path)
+
+
 def read_poses(path, min_poses=3):
     """[(rotation rows, translation)] of a KITTI pose file; ValueError if malformed or shorter
     than min_poses."""
@@ -130,10 +138,7 @@ def main(argv):
     text = "\n".join(lines) + "\n"
     sys.stdout.write(text)
     if markdown:
-        tmp = markdown + ".tmp"
-        with open(tmp, "w") as f:
-            f.write(text)
-        os.replace(tmp, markdown)
+        write_atomic(markdown, text)
     return 0
 
 

@@ -77,13 +77,18 @@ std::vector<char> GroundMask(const std::vector<Eigen::Vector3d>& points,
 // name -> per-frame values, in a fixed order of names.
 using Series = std::vector<std::pair<std::string, std::vector<double>>>;
 
+// Appends the series `name`: get(x) for every x of stats.
+template <typename Stats, typename Get>
+void AddSeries(const std::vector<Stats>& stats, const std::string& name, Get get, Series* out) {
+  std::vector<double> values;
+  values.reserve(stats.size());
+  for (const Stats& x : stats) values.push_back(static_cast<double>(get(x)));
+  out->emplace_back(name, std::move(values));
+}
+
 Series ScanSeries(const std::vector<ScanStats>& s) {
   Series out;
-  auto add = [&](const std::string& name, auto get) {
-    std::vector<double> v;
-    for (const auto& x : s) v.push_back(static_cast<double>(get(x)));
-    out.emplace_back(name, std::move(v));
-  };
+  auto add = [&](const std::string& name, auto get) { AddSeries(s, name, get, &out); };
   add("points", [](const ScanStats& x) { return x.points; });
   add("rings", [](const ScanStats& x) { return x.rings; });
   add("ring_points_median", [](const ScanStats& x) { return x.ring_points_median; });
@@ -108,11 +113,7 @@ Series ScanSeries(const std::vector<ScanStats>& s) {
 
 Series ImageSeries(const std::vector<ImageStats>& s) {
   Series out;
-  auto add = [&](const std::string& name, auto get) {
-    std::vector<double> v;
-    for (const auto& x : s) v.push_back(static_cast<double>(get(x)));
-    out.emplace_back(name, std::move(v));
-  };
+  auto add = [&](const std::string& name, auto get) { AddSeries(s, name, get, &out); };
   add("mean", [](const ImageStats& x) { return x.mean; });
   add("contrast", [](const ImageStats& x) { return x.contrast; });
   add("local_contrast", [](const ImageStats& x) { return x.local_contrast; });

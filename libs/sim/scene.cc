@@ -55,8 +55,9 @@ double LaidOutLength(const Route& route) {
   return length;
 }
 
-double LaidOutToRoute(const Route& route, double u) {
-  if (LaidOutLength(route) == route.length()) return u;  // Nothing repeated: the same numbers.
+// laid_out_length = LaidOutLength(route).
+double LaidOutToRoute(const Route& route, double laid_out_length, double u) {
+  if (laid_out_length == route.length()) return u;  // Nothing repeated: the same numbers.
   for (const RoadPiece& p : route.pieces()) {
     if (p.repeat) continue;
     if (u <= p.length) return p.s0 + u;
@@ -156,7 +157,7 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
   const double len = LaidOutLength(scene.route);
   const Terrain& tr = scene.terrain;
   for (double u = rng.Uniform(5, 15); u < len; u += rng.Uniform(25, 35)) {
-    const double s = LaidOutToRoute(scene.route, u);
+    const double s = LaidOutToRoute(scene.route, len, u);
     for (double side : {-1.0, 1.0}) {
       const RoadPoint rp = scene.route.At(s + (side > 0 ? 12 : 0));
       const Eigen::Vector2d p = rp.position + side * Normal(rp.heading) * (hw + 0.8);
@@ -166,7 +167,7 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
     }
   }
   for (double u = rng.Uniform(20, 40); u < len; u += rng.Uniform(55, 85)) {
-    const RoadPoint rp = scene.route.At(LaidOutToRoute(scene.route, u));
+    const RoadPoint rp = scene.route.At(LaidOutToRoute(scene.route, len, u));
     const Eigen::Vector2d p = rp.position - Normal(rp.heading) * (hw + 1.2);
     if (scene.route.Distance(p) < hw + 0.8 || InsideAnyBuilding(scene, p, 0.5)) continue;
     const double z = tr.Height(p.x(), p.y());
@@ -230,7 +231,7 @@ void PlaceHedges(Scene& scene, double coverage, Rng& rng) {
       const double run = rng.Uniform(15, 60);
       const double offset = rng.Uniform(0.5, 1.5);
       for (double t = s; t < std::min(s + run, length); t += 1.2) {
-        const RoadPoint rp = scene.route.At(LaidOutToRoute(scene.route, t));
+        const RoadPoint rp = scene.route.At(LaidOutToRoute(scene.route, length, t));
         const double r = rng.Uniform(0.9, 1.4);
         const Eigen::Vector2d p = rp.position + side * Normal(rp.heading) * (clear + offset + r);
         if (scene.route.Distance(p) < clear + r || InsideAnyBuilding(scene, p, r + 0.5)) continue;

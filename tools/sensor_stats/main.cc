@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/option_group.h"
 #include "app/tool.h"
 #include "core/check.h"
 #include "core/progress.h"
@@ -41,18 +42,13 @@ int main(int argc, char** argv) {
       cli.add_option("-o,--output", output, "Output JSON (sensor_stats artifact)")->required());
   cli.add_flag("--no-scans", no_scans, "Skip the LiDAR statistics");
   cli.add_flag("--no-images", no_images, "Skip the image statistics");
-  cli.add_option("--sensor-height", scan_options.sensor_height,
-                 "Nominal height of the LiDAR above the road (m)")
-      ->capture_default_str();
-  cli.add_option("--shape-radius", scan_options.radius,
-                 "Neighbourhood radius of the shape classes (m)")
-      ->capture_default_str();
-  cli.add_option("--shape-max-range", scan_options.shape_max_range,
-                 "Shape classes of points up to this range (m)")
-      ->capture_default_str();
-  cli.add_option("--fast-threshold", image_options.fast_threshold,
-                 "FAST threshold of the corner count")
-      ->capture_default_str();
+  jvl::app::OptionGroup stats(tool, "Statistics");
+  stats.Add("--sensor-height", scan_options.sensor_height,
+            "Nominal height of the LiDAR above the road (m)");
+  stats.Add("--shape-radius", scan_options.radius, "Neighbourhood radius of the shape classes (m)");
+  stats.Add("--shape-max-range", scan_options.shape_max_range,
+            "Shape classes of points up to this range (m)");
+  stats.Add("--fast-threshold", image_options.fast_threshold, "FAST threshold of the corner count");
 
   return tool.Run(argc, argv, [&] {
     scan_options.Check();
