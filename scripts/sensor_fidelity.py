@@ -24,8 +24,12 @@ SECTIONS = ("scan", "image")
 NOT_FRACTIONS = {
     "points", "rings", "ring_points_median", "ring_points_p10", "range_median_m", "shape_voxels",
     "intensity_median", "intensity_p90", "mean", "contrast", "local_contrast", "gradient_mean",
-    "gradient_p90", "fast_corners", "orb_keypoints",
+    "gradient_p90", "fast_corners", "orb_keypoints", "far_ahead", "far_behind", "far_ahead_p10",
+    "far_behind_p10",
 }
+# Statistics whose 10 % quantile over the frames is compared too: the frames where the scanner
+# sees no world ahead or behind are a tail, not the median.
+WITH_P10 = {"far_ahead", "far_behind"}
 
 
 def load(path):
@@ -43,6 +47,8 @@ def load(path):
             continue
         for name, v in part.items():
             out[(section, name)] = v.get("median")
+            if name in WITH_P10:
+                out[(section, name + "_p10")] = v.get("p10")
     if not out:
         raise ValueError(f"{path}: no statistics")
     return out, len(doc.get("frames", []))

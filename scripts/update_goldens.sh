@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 
 build=${1:-build}
 [ -f "$build/CMakeCache.txt" ] || { echo "update_goldens: $build is not a build folder (cmake -S . -B $build first)" >&2; exit 1; }
-cmake --build "$build" -j"$(nproc 2>/dev/null || echo 2)" --target golden sim_sequence make_prior \
+cmake --build "$build" -j"$(nproc 2>/dev/null || echo 2)" --target golden sim_sequence sim_map_check make_prior \
   lidar_odom vp_detect direction_cluster visual_assoc local_map global_opt evaluate > /dev/null
 bin=$(cd "$build/bin" && pwd)
 work=$(mktemp -d)

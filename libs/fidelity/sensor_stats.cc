@@ -108,6 +108,8 @@ Series ScanSeries(const std::vector<ScanStats>& s) {
   add("scattered", [](const ScanStats& x) { return x.scattered; });
   add("sparse", [](const ScanStats& x) { return x.sparse; });
   add("facing_forward", [](const ScanStats& x) { return x.facing_forward; });
+  add("far_ahead", [](const ScanStats& x) { return x.far_ahead; });
+  add("far_behind", [](const ScanStats& x) { return x.far_behind; });
   return out;
 }
 
@@ -159,6 +161,7 @@ void ScanStatsOptions::Check() const {
   JVL_CHECK(min_neighbours >= 3, "scan stats: min_neighbours must be >= 3, got " << min_neighbours);
   JVL_CHECK(normal_tolerance_deg > 0 && normal_tolerance_deg < 45,
             "scan stats: normal_tolerance_deg must be in (0, 45)");
+  JVL_CHECK(far_range > 0, "scan stats: far_range must be > 0, got " << far_range);
 }
 
 ScanStats ComputeScanStats(const PointCloud& scan, const ScanStatsOptions& o) {
@@ -203,6 +206,12 @@ ScanStats ComputeScanStats(const PointCloud& scan, const ScanStatsOptions& o) {
 
   const std::vector<char> ground = GroundMask(pts, o);
   s.ground_fraction = static_cast<double>(std::count(ground.begin(), ground.end(), 1)) / pts.size();
+
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector3d& p = pts[i];
+    if (ground[i] || p.head<2>().squaredNorm() <= o.far_range * o.far_range) continue;
+    if (std::abs(p.y()) < std::abs(p.x())) ++(p.x() > 0 ? s.far_ahead : s.far_behind);
+  }
 
   // Shape classes of the non-ground points within the shape ranges, one per voxel.
   std::vector<Eigen::Vector3d> others;

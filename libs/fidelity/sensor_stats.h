@@ -27,6 +27,7 @@ struct ScanStatsOptions {
   double radius = 0.5;            // Neighbourhood radius of the local shape (m).
   int min_neighbours = 6;         // Fewer neighbours (itself included): "sparse".
   double normal_tolerance_deg = 20;  // Planar with normal within this of horizontal: vertical.
+  double far_range = 40.0;           // Returns beyond this horizontal distance count as far (m).
   void Check() const;
 };
 
@@ -52,6 +53,11 @@ struct ScanStats {
   // axis, |n_x| >= 0.5. On a road, surfaces that face along it: what constrains a registration
   // along the direction of travel (facades and hedge rows parallel to the road do not).
   double facing_forward = 0;
+  // Non-ground returns beyond far_range (horizontal) within 45 degrees of the sensor's +x axis
+  // (ahead) and of its -x axis (behind): whether the world goes on along the road. Near zero
+  // ahead: the scanner looks into a void (a simulated world that ends) or at a near wall.
+  size_t far_ahead = 0;
+  size_t far_behind = 0;
 };
 
 // Rings: a new ring starts where, in storage order, the azimuth crosses the seam behind the

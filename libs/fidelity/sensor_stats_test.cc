@@ -87,6 +87,39 @@ TEST(ScanStats, FoliageIsScatteredAndAPoleLinear) {
   EXPECT_NEAR(p.linear + p.sparse, 1.0, 1e-12);
 }
 
+// A wall across the road 60 m ahead (x = 60) and nothing behind: far returns ahead are the
+// wall's returns above its base, none behind; the road is ground, not counted.
+TEST(ScanStats, FarReturnsAheadAndBehind) {
+  const auto wall_ahead = [](const Eigen::Vector3d& ray) {
+    double t = 1e9;
+    if (ray.z() < 0) t = std::min(t, -1.73 / ray.z());
+    if (ray.x() > 0) {
+      const double tw = 60.0 / ray.x();
+      if ((tw * ray).z() > -1.73 && std::abs((tw * ray).y()) < 30) t = std::min(t, tw);
+    }
+    return t < 100 ? t : -1;
+  };
+  PointCloud scan;
+  for (int r = 0; r < 40; ++r) AddRing(2000, (2.0 - 26.0 * r / 39) * M_PI / 180, wall_ahead, &scan);
+  // The wall's returns up to 1.2 m above the road may count as ground (far away, a cell's
+  // lowest return can be on the wall, within the ground band of the road's height).
+  size_t on_wall = 0, well_above = 0;
+  for (const auto& p : scan.points) {
+    on_wall += std::abs(p.x() - 60) < 1e-6;
+    well_above += std::abs(p.x() - 60) < 1e-6 && p.z() > -0.5;
+  }
+  const ScanStats s = ComputeScanStats(scan, ScanStatsOptions{});
+  ASSERT_GT(well_above, 500u);
+  EXPECT_GE(s.far_ahead, well_above);
+  EXPECT_LE(s.far_ahead, on_wall);
+  EXPECT_EQ(s.far_behind, 0u);
+  ScanStatsOptions beyond;  // The wall is nearer than 70 m: not far.
+  beyond.far_range = 70;
+  EXPECT_EQ(ComputeScanStats(scan, beyond).far_ahead, 0u);
+  beyond.far_range = 0;
+  EXPECT_THROW(ComputeScanStats(scan, beyond), std::exception);
+}
+
 TEST(ScanStats, EmptyScanAndBadOptions) {
   const ScanStats s = ComputeScanStats(PointCloud{}, ScanStatsOptions{});
   EXPECT_EQ(s.points, 0u);

@@ -62,6 +62,7 @@ RouteSummary SummarizeRoute(const World& world) {
   r.mean_speed = r.duration_s > 0 ? r.driven_length_m / r.duration_s : 0;
   const double s_end = gt.empty() ? 0 : DriveArcLength(world.drive, gt.timestamps.back());
   for (const RoadPiece& p : world.scene.route.pieces()) {
+    if (p.lead) continue;
     if (p.s0 + p.length > s_end + 1e-6) break;
     if (p.IsStraight()) {
       r.straights_100m += p.length >= 100 ? 1 : 0;
@@ -81,6 +82,7 @@ nlohmann::json DescribeScene(const World& world) {
   nlohmann::json j;
   j["scenario"] = ToString(world.options.scenario);
   j["seed"] = world.options.seed;
+  j["laps"] = world.options.laps;
   j["frames"] = world.ground_truth.size();
   j["map_frame"] = "x east, y north, z up (m); poses use world = cam0 of frame 0";
   j["world_from_map"] = Matrix4(world_from_map);
@@ -104,9 +106,14 @@ nlohmann::json DescribeScene(const World& world) {
                       {"start", Vec(p.start)},
                       {"start_heading_rad", p.start_heading},
                       {"speed_mps", p.speed},
-                      {"open", p.open}});
+                      {"open", p.open},
+                      {"repeat", p.repeat},
+                      {"lead", p.lead}});
   }
   j["route"] = {{"length_m", sc.route.length()},
+                {"drive_begin_m", sc.route.drive_begin()},
+                {"drive_end_m", sc.route.drive_end()},
+                {"road_beyond_m", world.options.road_beyond},
                 {"pieces", pieces},
                 {"half_width_m", sc.options.road_half_width},
                 {"lane_width_m", 3.5},

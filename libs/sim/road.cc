@@ -77,6 +77,15 @@ Route::Route(std::vector<RoadPiece> pieces, const Eigen::Vector2d& start, double
     if (!piece.repeat) all_pieces_.push_back(static_cast<int>(i));
   }
   JVL_CHECK(!all_pieces_.empty(), "route has only repeated pieces");
+  size_t first = 0, last = pieces_.size();
+  while (first < last && pieces_[first].lead) ++first;
+  while (last > first && pieces_[last - 1].lead) --last;
+  JVL_CHECK(first < last, "route has only lead pieces");
+  for (size_t i = first; i < last; ++i) {
+    JVL_CHECK(!pieces_[i].lead, "route piece " << i << " is a lead piece between driven ones");
+  }
+  drive_begin_ = pieces_[first].s0;
+  drive_end_ = pieces_[last - 1].s0 + pieces_[last - 1].length;
   // Grid index for Project(): a cell lists the pieces whose bounding circle comes within
   // kIndexReach of some point of the cell.
   const double half_diagonal = kIndexCell * std::sqrt(0.5);
@@ -314,6 +323,18 @@ std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps) {
   return pieces;
 }
 
+std::vector<RoadPiece> WithLeads(std::vector<RoadPiece> pieces, double length) {
+  JVL_CHECK(std::isfinite(length) && length >= 0, "lead length must be >= 0 m, got " << length);
+  if (length == 0 || pieces.empty()) return pieces;
+  RoadPiece in = Straight(length, pieces.front().speed, pieces.front().open);
+  RoadPiece out = Straight(length, pieces.back().speed, pieces.back().open);
+  in.lead = out.lead = true;
+  out.repeat = pieces.back().repeat;
+  pieces.insert(pieces.begin(), in);
+  pieces.push_back(out);
+  return pieces;
+}
+
 void DriveOptions::Check() const {
   JVL_CHECK(frame_rate_hz > 0, "frame_rate_hz must be > 0, got " << frame_rate_hz);
   JVL_CHECK(max_accel > 0 && max_decel > 0,
@@ -343,11 +364,13 @@ Drive PlanDrive(const Route& route, const DriveOptions& options) {
     }
     return v;
   };
-  double s = 0, v = std::min(pieces.front().speed, allowed(0.0)), stopped = 0;
+  const double begin = route.drive_begin(), end = route.drive_end();
+  double s = begin, v = std::min(pieces[route.PieceIndex(begin)].speed, allowed(begin)),
+         stopped = 0;
   bool stop_done = options.stop_at_s < 0;
   d.s.push_back(s);
   d.v.push_back(v);
-  while (s < route.length()) {
+  while (s < end) {
     double a = (allowed(s) - v) / 0.5;
     a = std::clamp(a, -options.max_decel * 1.5, options.max_accel);
     if (!stop_done && options.stop_at_s - s < 0.2) {
@@ -359,7 +382,7 @@ Drive PlanDrive(const Route& route, const DriveOptions& options) {
     v = std::max(0.0, v + a * d.dt);
     if (stop_done && v < 0.5) v = 0.5;  // Pull away after the stop.
     s += v * d.dt;
-    d.s.push_back(std::min(s, route.length()));
+    d.s.push_back(std::min(s, end));
     d.v.push_back(v);
     JVL_CHECK(d.s.size() < 10000000, "drive does not reach the end of the route");
   }

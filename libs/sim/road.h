@@ -24,6 +24,9 @@ struct RoadPiece {
   // driven back. The world is laid out along the other pieces; Route::Project and Distance
   // ignore it, so that a place has one arc length.
   bool repeat = false;
+  // Not driven: the road continuing beyond either end of the drive (see WithLeads), so that the
+  // world does not end where the drive does. The vehicle drives the pieces between the leads.
+  bool lead = false;
   // Filled by Route: start pose and arc-length offset.
   Eigen::Vector2d start = Eigen::Vector2d::Zero();
   double start_heading = 0;
@@ -46,6 +49,10 @@ class Route {
 
   const std::vector<RoadPiece>& pieces() const { return pieces_; }
   double length() const { return length_; }
+  // The arc lengths where the drive begins and ends: the route without its lead pieces at
+  // either end (0 and length() when it has none).
+  double drive_begin() const { return drive_begin_; }
+  double drive_end() const { return drive_end_; }
   // Centre line at arc length s (clamped to [0, length]).
   RoadPoint At(double s) const;
   // Nearest centre-line point over all pieces (exact projection onto lines and circles):
@@ -80,6 +87,7 @@ class Route {
   std::vector<int> all_pieces_;     // 0 .. pieces - 1
   std::unordered_map<uint64_t, std::vector<int>> index_;
   double length_ = 0;
+  double drive_begin_ = 0, drive_end_ = 0;
 };
 
 // Rolling terrain: a sum of long-wavelength sinusoids (slopes of a few percent).
@@ -107,6 +115,13 @@ bool IsHighwayLike(Scenario scenario);
 // that the route zigzags on without crossing itself (urban: 9 laps = 4.3 km, 4779 frames). For
 // kLoop, `laps` is the number of circuits of the block (pieces after the first marked repeat).
 std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps = 1);
+// `pieces` with a straight lead piece of `length` metres before the first and after the last
+// one (none when length is 0): the road and its world continue straight beyond the ends of the
+// drive, as real roads do, instead of ending where the drive does. The leads take the speed and
+// the openness of their neighbours; the trailing one is marked repeat when the last piece is (a
+// route that ends driving back along its first street retraces the leading one). The route's
+// start then lies `length` metres before the drive's.
+std::vector<RoadPiece> WithLeads(std::vector<RoadPiece> pieces, double length);
 
 struct DriveOptions {
   double frame_rate_hz = 10.0;
@@ -130,7 +145,8 @@ struct DriveOptions {
   void Check() const;
 };
 
-// Vehicle motion: arc length and speed sampled at 100 Hz from t = 0 until the route ends.
+// Vehicle motion: arc length and speed sampled at 100 Hz from t = 0 (at route.drive_begin())
+// until route.drive_end().
 struct Drive {
   double dt = 0.01;
   std::vector<double> s, v;

@@ -156,6 +156,62 @@ TEST(DriveTest, DefaultDemoMeetsTheBrief) {
   EXPECT_LT(world->ground_truth.world_from_cam[0].translation().norm(), 1e-9);
 }
 
+// The road and the world continue beyond both ends of the drive: the drive covers exactly the
+// scenario's pieces, from the map origin, and buildings stand along the road past its end.
+TEST(DriveTest, TheWorldContinuesBeyondBothEndsOfTheDrive) {
+  const std::vector<RoadPiece> pieces = ScenarioRoute(Scenario::kUrban);
+  double driven = 0;
+  for (const RoadPiece& p : pieces) driven += p.length;
+  SequenceOptions opt;
+  ASSERT_EQ(opt.road_beyond, 120.0);
+  const auto world = BuildWorld(opt);
+  const Route& route = world->scene.route;
+  ASSERT_EQ(route.pieces().size(), pieces.size() + 2);
+  EXPECT_TRUE(route.pieces().front().lead && route.pieces().back().lead);
+  EXPECT_NEAR(route.drive_begin(), 120.0, 1e-9);
+  EXPECT_NEAR(route.drive_end() - route.drive_begin(), driven, 1e-9);
+  EXPECT_NEAR(route.length(), driven + 240.0, 1e-9);
+  EXPECT_LT(route.At(route.drive_begin()).position.norm(), 1e-9);  // The drive starts at 0.
+  EXPECT_DOUBLE_EQ(world->drive.s.front(), route.drive_begin());
+  EXPECT_DOUBLE_EQ(world->drive.s.back(), route.drive_end());
+  // Buildings along the lead pieces, beyond both ends of the drive.
+  int before = 0, after = 0;
+  for (const Building& b : world->scene.buildings) {
+    double s, lateral;
+    route.Project(b.center, &s, &lateral);
+    before += s < route.drive_begin() - 20 ? 1 : 0;
+    after += s > route.drive_end() + 20 ? 1 : 0;
+  }
+  EXPECT_GE(before, 4);
+  EXPECT_GE(after, 4);
+  // The summary describes the drive only (the leads are not turns or straights of it).
+  const RouteSummary r = SummarizeRoute(*world);
+  opt.road_beyond = 0;  // The former world: it ends where the drive does.
+  const auto bare = BuildWorld(opt);
+  const RouteSummary r0 = SummarizeRoute(*bare);
+  EXPECT_EQ(r.turns, r0.turns);
+  EXPECT_EQ(r.straights_100m, r0.straights_100m);
+  EXPECT_NEAR(r.driven_length_m, r0.driven_length_m, 0.5);
+  EXPECT_EQ(bare->scene.route.pieces().size(), pieces.size());
+  EXPECT_EQ(bare->scene.route.drive_begin(), 0.0);
+  EXPECT_EQ(bare->scene.route.drive_end(), bare->scene.route.length());
+  opt.road_beyond = -1;
+  EXPECT_THROW(BuildWorld(opt), std::exception);
+}
+
+// A loop route ends driving back along its first street: the trailing lead retraces the
+// leading one (marked repeat), so the world is laid out there once.
+TEST(RouteTest, LoopLeadsRetraceEachOther) {
+  const Route route(WithLeads(ScenarioRoute(Scenario::kLoop, 2), 100), Eigen::Vector2d(-100, 0),
+                    0.0);
+  const RoadPiece& in = route.pieces().front();
+  const RoadPiece& out = route.pieces().back();
+  EXPECT_TRUE(in.lead && out.lead && out.repeat && !in.repeat);
+  EXPECT_LT((route.At(route.length()).position - in.start).norm(), 1e-6);
+  EXPECT_LT(route.At(route.drive_begin()).position.norm(), 1e-9);
+  EXPECT_LT(route.At(route.drive_end()).position.norm(), 1e-6);
+}
+
 TEST(TerrainTest, ScaleMultipliesTheHeightsAndZeroIsFlat) {
   SequenceOptions opt;
   opt.frames = 5;

@@ -244,13 +244,16 @@ void PlaceHedges(Scene& scene, double coverage, Rng& rng) {
 }
 
 void PlaceMovingCars(Scene& scene, Rng& rng) {
-  const double len = scene.route.length();
+  // Placed relative to the drive: cars ahead in the lane, oncoming ones along the whole drive.
+  const double begin = scene.route.drive_begin();
+  const double len = scene.route.drive_end() - begin;
   for (int i = 0; i < scene.options.moving_cars; ++i) {
     MovingCar car;
     const bool oncoming = i % 2 == 0;
     const double v = IsHighwayLike(scene.options.scenario) ? 24 : 11;
     car.speed = oncoming ? -rng.Uniform(0.8 * v, v) : rng.Uniform(v, 1.15 * v);
-    car.s0 = oncoming ? rng.Uniform(0.3 * len, 1.3 * len) : rng.Uniform(25, 70) + 60.0 * i;
+    car.s0 =
+        begin + (oncoming ? rng.Uniform(0.3 * len, 1.3 * len) : rng.Uniform(25, 70) + 60.0 * i);
     car.lateral = oncoming ? 1.75 : -1.75;
     car.size = Eigen::Vector3d(rng.Uniform(4.0, 4.8), rng.Uniform(1.7, 1.9), rng.Uniform(1.4, 1.6));
     scene.moving_cars.push_back(car);

@@ -37,9 +37,12 @@ Calibration KittiCalibration() {
 
 void SequenceOptions::Check() const {
   JVL_CHECK(frames >= 0, "frames must be >= 0 (0 = whole route), got " << frames);
-  JVL_CHECK(lidar_height > 0.5 && lidar_height < 5, "lidar_height must be in (0.5, 5) m, got " << lidar_height);
+  JVL_CHECK(lidar_height > 0.5 && lidar_height < 5,
+            "lidar_height must be in (0.5, 5) m, got " << lidar_height);
   JVL_CHECK(calibration.image_width > 0 && calibration.image_height > 0,
             "calibration has no image size");
+  JVL_CHECK(std::isfinite(road_beyond) && road_beyond >= 0 && road_beyond <= 1000,
+            "road_beyond must be in [0, 1000] m, got " << road_beyond);
   drive.Check();
   scene.Check();
   lidar.Check();
@@ -63,7 +66,12 @@ std::unique_ptr<World> BuildWorld(const SequenceOptions& options) {
   options.Check();
   auto world = std::make_unique<World>();
   world->options = options;
-  const Route route(ScenarioRoute(options.scenario, options.laps), Eigen::Vector2d::Zero(), 0.35);
+  // The drive starts at the map origin heading 0.35 rad; the lead piece before it starts
+  // road_beyond metres back.
+  constexpr double kHeading = 0.35;
+  const Route route(WithLeads(ScenarioRoute(options.scenario, options.laps), options.road_beyond),
+                    -options.road_beyond * Eigen::Vector2d(std::cos(kHeading), std::sin(kHeading)),
+                    kHeading);
   SceneOptions scene_options = options.scene;
   scene_options.scenario = options.scenario;
   scene_options.seed = options.seed;
@@ -74,7 +82,7 @@ std::unique_ptr<World> BuildWorld(const SequenceOptions& options) {
     for (const RoadPiece& p : route.pieces()) {
       if (std::abs(p.curvature) > 0.05 && ++corners == 2) drive.stop_at_s = p.s0 - 12;
     }
-    if (drive.stop_at_s < 0) drive.stop_at_s = route.length() / 2;
+    if (drive.stop_at_s < 0) drive.stop_at_s = (route.drive_begin() + route.drive_end()) / 2;
   }
   world->options.drive = drive;
   world->drive = PlanDrive(route, drive);

@@ -29,9 +29,13 @@ Calibration KittiCalibration();
 struct SequenceOptions {
   Scenario scenario = Scenario::kUrban;
   uint64_t seed = 1;
-  int64_t frames = 0;          // 0: drive the whole route.
-  int laps = 1;                // Route repetitions (see ScenarioRoute), for long sequences.
-  bool stop = false;           // Stop for a few seconds before the second corner.
+  int64_t frames = 0;  // 0: drive the whole route.
+  int laps = 1;        // Route repetitions (see ScenarioRoute), for long sequences.
+  bool stop = false;   // Stop for a few seconds before the second corner.
+  // The road and its world continue this far (m) straight beyond both ends of the drive (lead
+  // pieces, WithLeads): real drives never see the end of the world. Default: the LiDAR's
+  // maximum range. 0: the world ends where the drive does.
+  double road_beyond = 120.0;
   double lidar_height = 1.73;  // Velodyne above the road (KITTI setup).
   Calibration calibration = KittiCalibration();
   DriveOptions drive;

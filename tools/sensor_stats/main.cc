@@ -48,6 +48,10 @@ int main(int argc, char** argv) {
   stats.Add("--shape-radius", scan_options.radius, "Neighbourhood radius of the shape classes (m)");
   stats.Add("--shape-max-range", scan_options.shape_max_range,
             "Shape classes of points up to this range (m)");
+  stats.Add(
+      "--far-range", scan_options.far_range,
+      "Non-ground returns beyond this horizontal distance (m), ahead and behind, are far_ahead "
+      "and far_behind");
   stats.Add("--fast-threshold", image_options.fast_threshold, "FAST threshold of the corner count");
 
   return tool.Run(argc, argv, [&] {

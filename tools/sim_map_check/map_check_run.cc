@@ -50,11 +50,16 @@ sim::SequenceOptions WorldOptionsFromScene(const nlohmann::json& scene, const st
     o.scenario = sim::ParseScenario(Field(scene, "scenario", what).get<std::string>());
     o.seed = Field(scene, "seed", what).get<uint64_t>();
     o.frames = Field(scene, "frames", what).get<int64_t>();
-    o.stop = Field(Field(scene, "summary", what), "stop_at_s", what).get<double>() >= 0;
+    const nlohmann::json& summary = Field(scene, "summary", what);
+    o.stop = Field(summary, "stop_at_s", what).get<double>() >= 0;
+    // Fields added over time; older files were written with the values of their day.
+    o.laps = scene.value("laps", 1);
+    o.drive.steer_transition = summary.value("steer_transition_m", 0.0);
+    o.drive.body_vibration = summary.value("body_vibration_deg", 0.0);
+    o.road_beyond = Field(scene, "route", what).value("road_beyond_m", 0.0);
     o.scene.moving_cars = static_cast<int>(Field(scene, "moving_cars", what).size());
     // Written since the terrain became scalable; older files have the default scale.
     o.scene.terrain_scale = Field(scene, "terrain", what).value("scale", 1.0);
-    // Written since crowns became volumes of leaf clumps; older files had opaque crowns.
     // Written since crowns became volumes of leaf clumps and the roadsides got hedges; older
     // files had opaque crowns and no hedges.
     const nlohmann::json vegetation = scene.value("vegetation", nlohmann::json::object());

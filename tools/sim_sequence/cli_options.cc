@@ -10,6 +10,10 @@ void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
             "Drive the route this many times, every second lap mirrored (long sequences); "
             "with --scenario loop: circuits of the block");
   route.Add("--seed", o->seed, "Random seed (world layout and noise)");
+  route.Add("--road-beyond", "road_beyond", o->road_beyond,
+            "The road and the world along it continue this far (m) straight beyond both ends "
+            "of the drive (default: the LiDAR's maximum range); 0: the world ends where the "
+            "drive does");
   route.Flag("--stop", o->stop, "Stop for a few seconds before the second corner");
   route.Add("--steer-transition", o->drive.steer_transition,
             "Arc length (m) over which the vehicle's curvature, yaw rate and body roll ramp into "
