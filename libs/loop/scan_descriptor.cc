@@ -1,0 +1,92 @@
+#include "loop/scan_descriptor.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+
+namespace jvl::loop {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+}  // namespace
+
+void ScanDescriptorOptions::Check() const {
+  JVL_CHECK(rings >= 1 && rings <= 1000,
+            "scan descriptor: rings must be in [1, 1000], got " << rings);
+  JVL_CHECK(sectors >= 4 && sectors <= 3600,
+            "scan descriptor: sectors must be in [4, 3600], got " << sectors);
+  JVL_CHECK(std::isfinite(max_range) && max_range > 0,
+            "scan descriptor: max_range must be > 0, got " << max_range);
+  JVL_CHECK(std::isfinite(sensor_height), "scan descriptor: sensor_height must be finite");
+}
+
+ScanDescriptor ComputeScanDescriptor(const std::vector<Eigen::Vector3d>& points,
+                                     const ScanDescriptorOptions& o) {
+  o.Check();
+  ScanDescriptor d;
+  d.cells = Eigen::MatrixXf::Zero(o.rings, o.sectors);
+  Eigen::MatrixXi hit = Eigen::MatrixXi::Zero(o.rings, o.sectors);
+  for (const Eigen::Vector3d& p : points) {
+    if (!p.allFinite()) continue;
+    const double range = p.head<2>().norm();
+    if (range <= 0 || range > o.max_range) continue;
+    const int r = std::min(o.rings - 1, static_cast<int>(range / o.max_range * o.rings));
+    double azimuth = std::atan2(p.y(), p.x());
+    if (azimuth < 0) azimuth += 2 * kPi;
+    const int s = std::min(o.sectors - 1, static_cast<int>(azimuth / (2 * kPi) * o.sectors));
+    const float height = static_cast<float>(std::max(0.0, p.z() + o.sensor_height));
+    hit(r, s) = 1;
+    d.cells(r, s) = std::max(d.cells(r, s), height);
+  }
+  d.ring_key = hit.cast<float>().rowwise().mean();
+  return d;
+}
+
+DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor& b) {
+  JVL_CHECK(
+      a.cells.rows() == b.cells.rows() && a.cells.cols() == b.cells.cols() && a.cells.size() > 0,
+      "scan descriptors of different or empty shapes: " << a.cells.rows() << " x " << a.cells.cols()
+                                                        << " and " << b.cells.rows() << " x "
+                                                        << b.cells.cols());
+  const int sectors = static_cast<int>(a.cells.cols());
+  const Eigen::MatrixXd cells_a = a.cells.cast<double>(), cells_b = b.cells.cast<double>();
+  const Eigen::VectorXd norm_a = cells_a.colwise().norm();
+  const Eigen::VectorXd norm_b = cells_b.colwise().norm();
+  DescriptorMatch best;
+  best.distance = 2;
+  for (int shift = 0; shift < sectors; ++shift) {
+    double sum = 0;
+    int counted = 0;
+    for (int s = 0; s < sectors; ++s) {
+      const int t = (s + shift) % sectors;
+      const bool in_a = norm_a(s) > 0, in_b = norm_b(t) > 0;
+      if (!in_a && !in_b) continue;
+      ++counted;
+      if (in_a && in_b) {
+        const double cosine = cells_a.col(s).dot(cells_b.col(t)) / (norm_a(s) * norm_b(t));
+        sum += std::max(0.0, 1.0 - cosine);
+      } else {
+        sum += 1.0;
+      }
+    }
+    const double distance = counted > 0 ? sum / counted : 1.0;
+    if (distance < best.distance) {  // The first shift wins ties: deterministic.
+      best.distance = distance;
+      best.shift = shift;
+    }
+  }
+  const int signed_shift = best.shift > sectors / 2 ? best.shift - sectors : best.shift;
+  best.yaw = 2 * kPi * signed_shift / sectors;
+  return best;
+}
+
+double RingKeyDistance(const ScanDescriptor& a, const ScanDescriptor& b) {
+  JVL_CHECK(
+      a.ring_key.size() == b.ring_key.size(),
+      "ring keys of different lengths: " << a.ring_key.size() << " and " << b.ring_key.size());
+  return (a.ring_key - b.ring_key).norm();
+}
+
+}  // namespace jvl::loop
