@@ -44,7 +44,7 @@ ScanDescriptor ComputeScanDescriptor(const std::vector<Eigen::Vector3d>& points,
   return d;
 }
 
-DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor& b) {
+std::vector<double> ShiftDistances(const ScanDescriptor& a, const ScanDescriptor& b) {
   JVL_CHECK(
       a.cells.rows() == b.cells.rows() && a.cells.cols() == b.cells.cols() && a.cells.size() > 0,
       "scan descriptors of different or empty shapes: " << a.cells.rows() << " x " << a.cells.cols()
@@ -54,8 +54,7 @@ DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor
   const Eigen::MatrixXd cells_a = a.cells.cast<double>(), cells_b = b.cells.cast<double>();
   const Eigen::VectorXd norm_a = cells_a.colwise().norm();
   const Eigen::VectorXd norm_b = cells_b.colwise().norm();
-  DescriptorMatch best;
-  best.distance = 2;
+  std::vector<double> out(static_cast<size_t>(sectors));
   for (int shift = 0; shift < sectors; ++shift) {
     double sum = 0;
     int counted = 0;
@@ -71,9 +70,40 @@ DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor
         sum += 1.0;
       }
     }
-    const double distance = counted > 0 ? sum / counted : 1.0;
-    if (distance < best.distance) {  // The first shift wins ties: deterministic.
-      best.distance = distance;
+    out[static_cast<size_t>(shift)] = counted > 0 ? sum / counted : 1.0;
+  }
+  return out;
+}
+
+DescriptorMatch BestShiftNear(const std::vector<double>& distances, int centre, int window) {
+  const int sectors = static_cast<int>(distances.size());
+  JVL_CHECK(sectors > 0 && window >= 0, "BestShiftNear: no distances or a negative window");
+  DescriptorMatch best;
+  best.distance = 2;
+  // From centre outwards (centre, +1, -1, +2, ...): ties go to the shift nearest the centre.
+  for (int k = 0; k <= std::min(window, sectors / 2); ++k) {
+    for (int sign : {1, -1}) {
+      if (k == 0 && sign < 0) continue;
+      const int shift = (((centre + sign * k) % sectors) + sectors) % sectors;
+      if (distances[static_cast<size_t>(shift)] < best.distance) {
+        best.distance = distances[static_cast<size_t>(shift)];
+        best.shift = shift;
+      }
+    }
+  }
+  const int signed_shift = best.shift > sectors / 2 ? best.shift - sectors : best.shift;
+  best.yaw = 2 * kPi * signed_shift / sectors;
+  return best;
+}
+
+DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor& b) {
+  const std::vector<double> distances = ShiftDistances(a, b);
+  const int sectors = static_cast<int>(distances.size());
+  DescriptorMatch best;
+  best.distance = 2;
+  for (int shift = 0; shift < sectors; ++shift) {
+    if (distances[static_cast<size_t>(shift)] < best.distance) {  // First shift wins ties.
+      best.distance = distances[static_cast<size_t>(shift)];
       best.shift = shift;
     }
   }

@@ -40,6 +40,10 @@ struct DescriptorMatch {
 // columns), minimised over the column shifts of b. Columns empty in one of the two count as
 // dissimilar (1) unless empty in both; two empty descriptors are at distance 1.
 DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor& b);
+// The same distance at every shift 0 .. sectors - 1.
+std::vector<double> ShiftDistances(const ScanDescriptor& a, const ScanDescriptor& b);
+// The best shift within `window` sectors of `centre` (either side, wrapping round).
+DescriptorMatch BestShiftNear(const std::vector<double>& distances, int centre, int window);
 
 // Distance of the ring keys (Euclidean): the first, rotation-invariant filter of candidates.
 double RingKeyDistance(const ScanDescriptor& a, const ScanDescriptor& b);

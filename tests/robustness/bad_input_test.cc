@@ -557,6 +557,13 @@ TEST_F(BadInputTest, InvalidOptions) {
               "--no-scans and --no-images leave nothing");
   ExpectError("sensor_stats", "-d " + kSeq + " -o " + Bad("s.json") + " --shape-radius 0",
               "voxel_size and radius must be > 0");
+  const std::string loops = "-d " + kSeq + " --poses " + In("odom.h5") + " -o " + Bad("l.h5");
+  ExpectError("loop_detect", loops + " --every 0", "--every");
+  ExpectError("loop_detect", loops + " --max-descriptor-distance 0",
+              "--max-descriptor-distance must be in (0, 1]");
+  ExpectError("loop_detect", loops + " --consistency 0", "--consistency must be >= 1");
+  ExpectError("loop_detect", "-d " + kSeq + " --poses " + Bad("none.h5") + " -o " + Bad("l.h5"),
+              "none.h5");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --sequence 1x",
               "--sequence must be two digits");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --frames 100000", "--frames 100000 exceeds");

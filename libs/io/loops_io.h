@@ -1,0 +1,47 @@
+// The "loops" artifact (schema loops v1, schemas/loops.schema.json) written by loop_detect: the
+// keyframes searched and every verified loop candidate, accepted or not, with its relative pose,
+// scores and the detector that proposed it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "geometry/rigid3.h"
+#include "io/artifact.h"
+
+namespace jvl::io {
+
+constexpr char kLoopsSchema[] = "loops";
+constexpr int kLoopsSchemaVersion = 1;
+
+// One verified candidate, as stored (plain values, independent of the loop library).
+struct LoopRecord {
+  int64_t query = 0;         // The later keyframe (dataset frame) ...
+  int64_t match = 0;         // ... and the earlier one it was matched to.
+  int32_t detector = 0;      // 0 = LiDAR descriptor, 1 = visual words.
+  int32_t status = 0;        // 0 = accepted; > 0: why not (LoopStatus of libs/loop).
+  Rigid3d match_from_query;  // cam0 frames.
+  double score = 0;          // Detector's distance (LiDAR: descriptor distance, 0 = identical).
+  double ring_key_distance = 0;
+  double yaw_deg = 0;  // Detector's yaw estimate of the query relative to the match.
+  int32_t correspondences = 0;
+  double residual = 0;  // m, RMS IMLS distance after registration.
+};
+
+struct LoopsData {
+  std::vector<int64_t> keyframes;  // Frames searched, increasing.
+  std::vector<LoopRecord> loops;   // Ordered by query.
+};
+
+void WriteLoopsArtifact(const std::string& path, const LoopsData& data,
+                        const Provenance& provenance);
+// Reads and checks the layout (lengths agree, frames are keyframes, match < query).
+LoopsData ReadLoopsArtifact(const std::string& path);
+
+// CSV: header "query,match,detector,status,score,ring_key_distance,yaw_deg,correspondences,
+// residual,tx,ty,tz" (tx, ty, tz: translation of match_from_query), shortest round-trip numbers.
+std::string FormatLoopsCsv(const LoopsData& data);
+void WriteLoopsCsv(const std::string& path, const LoopsData& data);
+
+}  // namespace jvl::io

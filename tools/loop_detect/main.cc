@@ -1,0 +1,193 @@
+// loop_detect: loop closures of a drive (the paper's loop-closing module, supplement 1.3).
+// Reads the dataset's scans and a trajectory (the prior or the odometry: only its path length is
+// used, to skip the keyframes just driven), finds revisited places with the LiDAR place
+// descriptor, verifies each candidate by registering the two scans, and writes every verified
+// candidate, accepted or not, to a loops artifact. With --gt it reports the revisits of the
+// ground truth and how many were found (recall) and how many loops were right (precision).
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "app/option_group.h"
+#include "app/tool.h"
+#include "core/check.h"
+#include "core/progress.h"
+#include "core/strings.h"
+#include "io/dataset.h"
+#include "io/loops_io.h"
+#include "io/trajectory_io.h"
+#include "loop/lidar_loops.h"
+
+namespace {
+
+using namespace jvl;
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+// Keyframes: every `every`-th frame of the trajectory that the dataset has.
+Trajectory SelectKeyframes(const Trajectory& poses, const io::Dataset& dataset, int every) {
+  Trajectory out;
+  const auto& frames = dataset.frames();
+  size_t count = 0;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (!std::binary_search(frames.begin(), frames.end(), poses.frames[i])) continue;
+    if (count++ % static_cast<size_t>(every) == 0)
+      out.Append(poses.frames[i], poses.world_from_cam[i]);
+  }
+  return out;
+}
+
+// Against the ground truth: a keyframe revisits a place when an earlier keyframe at least
+// min_separation back along the true path lies within 5 m (same direction: headings within
+// 30 deg; opposite: more than 150 deg apart). A loop is right when its relative pose is within
+// 1 m and 2 deg of the true one.
+void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
+                              double min_separation) {
+  std::vector<size_t> index;
+  Trajectory kf;
+  for (const int64_t f : loops.keyframes) {
+    const auto i = gt.IndexOf(f);
+    JVL_CHECK(i, "--gt has no pose for keyframe " << f);
+    kf.Append(f, gt.world_from_cam[*i]);
+  }
+  const size_t n = kf.size();
+  std::vector<double> path(n, 0.0);
+  for (size_t i = 1; i < n; ++i)
+    path[i] = path[i - 1] +
+              (kf.world_from_cam[i].translation() - kf.world_from_cam[i - 1].translation()).norm();
+  std::vector<int> kind(n, 0);  // 0 none, 1 same direction, 2 opposite.
+  for (size_t q = 0; q < n; ++q) {
+    const Eigen::Vector3d zq = kf.world_from_cam[q].rotation() * Eigen::Vector3d::UnitZ();
+    for (size_t j = 0; j < q && path[q] - path[j] >= min_separation; ++j) {
+      if ((kf.world_from_cam[q].translation() - kf.world_from_cam[j].translation()).norm() > 5)
+        continue;
+      const Eigen::Vector3d zj = kf.world_from_cam[j].rotation() * Eigen::Vector3d::UnitZ();
+      const double angle = std::acos(std::clamp(zq.dot(zj), -1.0, 1.0)) * kRadToDeg;
+      if (angle < 30) kind[q] = 1;
+      if (angle > 150 && kind[q] == 0) kind[q] = 2;
+    }
+  }
+  std::vector<int> found(n, 0);
+  int accepted = 0, right = 0;
+  for (const io::LoopRecord& r : loops.loops) {
+    if (r.status != 0) continue;
+    ++accepted;
+    const auto q = gt.IndexOf(r.query), m = gt.IndexOf(r.match);
+    const Rigid3d truth = gt.world_from_cam[*m].Inverse() * gt.world_from_cam[*q];
+    const Rigid3d error = truth.Inverse() * r.match_from_query;
+    const bool ok =
+        error.translation().norm() <= 1 && RotationAngle(error.rotation()) * kRadToDeg <= 2;
+    right += ok ? 1 : 0;
+    if (!ok) {
+      spdlog::warn(
+          "loop {} -> {} is wrong: {:.2f} m apart in truth, relative pose off by {:.2f} m, {:.2f} "
+          "deg",
+          r.query, r.match, truth.translation().norm(), error.translation().norm(),
+          RotationAngle(error.rotation()) * kRadToDeg);
+    }
+    const auto k = std::lower_bound(loops.keyframes.begin(), loops.keyframes.end(), r.query) -
+                   loops.keyframes.begin();
+    if (ok) found[static_cast<size_t>(k)] = 1;
+  }
+  int same = 0, opposite = 0, same_found = 0, opposite_found = 0;
+  for (size_t q = 0; q < n; ++q) {
+    if (kind[q] == 1) same += 1, same_found += found[q];
+    if (kind[q] == 2) opposite += 1, opposite_found += found[q];
+  }
+  auto pct = [](int a, int b) {
+    return b > 0 ? fmt::format("{:.0f} %", 100.0 * a / b) : std::string("-");
+  };
+  spdlog::info(
+      "against --gt: {} accepted loops, {} right (precision {}); revisiting keyframes "
+      "{} in the same direction, {} found (recall {}), {} in the opposite direction, "
+      "{} found (recall {})",
+      accepted, right, pct(right, accepted), same, same_found, pct(same_found, same), opposite,
+      opposite_found, pct(opposite_found, opposite));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  app::Tool tool("loop_detect",
+                 "Loop closures of a drive: revisited places found with a LiDAR place descriptor "
+                 "(polar grid of largest heights, rotation-invariant ring key), each candidate "
+                 "verified by registering the two scans; every verified candidate, accepted or "
+                 "not, goes to the loops artifact.");
+  std::string dataset_dir, format = "auto", frames = ":", poses_path, output, gt_path, csv;
+  int every = 5;
+  loop::LidarLoopOptions options;
+  CLI::App& cli = tool.cli();
+  cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
+      ->required();
+  cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
+  cli.add_option("--poses", poses_path,
+                 "Trajectory of the drive (odometry or prior: .h5 artifact, KITTI or TUM text); "
+                 "only its path length is used, to skip the keyframes just driven")
+      ->required();
+  cli.add_option("--every", every, "Keyframes: every K-th frame of the trajectory")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  tool.OutputFile(cli.add_option("-o,--output", output, "Output loops artifact (.h5)")->required());
+  tool.OutputFile(
+      cli.add_option("--csv", csv,
+                     "Also write the candidates as CSV (query, match, detector, status, "
+                     "scores, registration, relative translation)"));
+  cli.add_option("--gt", gt_path,
+                 "Ground-truth trajectory: report the revisits and the loops' recall and "
+                 "precision in the log");
+  app::OptionGroup lidar(tool, "LiDAR detector");
+  lidar.Add("--min-separation", "min_separation_m", options.min_separation_m,
+            "Candidates lie at least this far back along the path (m)");
+  lidar.Add("--max-descriptor-distance", "max_descriptor_distance", options.max_descriptor_distance,
+            "Verify the best candidate only below this descriptor distance (0 = identical, 1)");
+  lidar.Add("--max-residual", "max_residual", options.max_residual,
+            "Accept a registration with an RMS IMLS distance up to this (m)");
+  lidar.Add("--min-correspondences", "min_correspondences", options.min_correspondences,
+            "Accept a registration with at least this many correspondences");
+  lidar.Add("--consistency", "consistency", options.consistency,
+            "Accept a loop when this many consecutive keyframes have verified matches that agree");
+
+  return tool.Run(argc, argv, [&] {
+    options.Check();
+    const auto dataset =
+        io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
+    tool.AddDataset(*dataset, dataset_dir);
+    tool.AddInput(poses_path);
+    const Trajectory poses = io::ReadTrajectory(poses_path);
+    const Trajectory keyframes = SelectKeyframes(poses, *dataset, every);
+    JVL_CHECK(keyframes.size() >= 2,
+              poses_path << ": fewer than 2 of its frames are in the dataset");
+    Progress progress("keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
+    const loop::LidarLoopResult result = loop::DetectLidarLoops(
+        keyframes, [&](int64_t f) { return dataset->LoadScan(f); }, dataset->calibration(), options,
+        tool.threads(), [&] { progress.Tick(); });
+    io::LoopsData data;
+    data.keyframes = result.keyframes;
+    int accepted = 0;
+    for (const loop::LoopCandidate& c : result.candidates) {
+      io::LoopRecord r;
+      r.query = c.query;
+      r.match = c.match;
+      r.detector = 0;
+      r.status = static_cast<int32_t>(c.status);
+      r.match_from_query = c.match_from_query;
+      r.score = c.descriptor_distance;
+      r.ring_key_distance = c.ring_key_distance;
+      r.yaw_deg = c.yaw_rad * kRadToDeg;
+      r.correspondences = c.correspondences;
+      r.residual = c.residual;
+      data.loops.push_back(r);
+      accepted += c.status == loop::LoopStatus::kAccepted ? 1 : 0;
+    }
+    io::WriteLoopsArtifact(output, data, tool.MakeProvenance());
+    if (!csv.empty()) io::WriteLoopsCsv(csv, data);
+    spdlog::info("loop_detect: {} keyframes, {} candidates verified, {} loops accepted -> {}",
+                 data.keyframes.size(), data.loops.size(), accepted, output);
+    if (!gt_path.empty()) {
+      ReportAgainstGroundTruth(io::ReadTrajectory(gt_path), data, options.min_separation_m);
+    }
+  });
+}
