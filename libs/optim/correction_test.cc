@@ -56,6 +56,13 @@ TEST(DistributeCorrection, UsesPositionsAndRejectsBadInput) {
   EXPECT_THROW(DistributeCorrection(poses, corrected_n, {3, 3, 3}), Error);
 }
 
+TEST(DistributeCorrection, IdentityCorrectionIsANoOp) {
+  const std::vector<Rigid3d> poses = StraightKeyframes(6);
+  const std::vector<Rigid3d> out = DistributeCorrection(poses, poses.back());
+  ASSERT_EQ(out.size(), poses.size());
+  for (size_t i = 0; i < poses.size(); ++i) ExpectPoseNear(out[i], poses[i], 1e-12);
+}
+
 Trajectory PriorTrajectory(int count) {
   Trajectory t;
   for (int i = 0; i < count; ++i) {
