@@ -134,6 +134,7 @@ LidarLoopResult DetectLidarLoops(const Trajectory& keyframes,
     std::vector<std::pair<Pick, std::vector<double>>> scored;
     for (size_t c = 0; c < keep; ++c) {
       std::vector<double> d = ShiftDistances(descriptors[near[c].second], descriptors[q]);
+      // As CompareDescriptors, keeping the distances for the opposite yaw below.
       const DescriptorMatch m = BestShiftNear(d, 0, o.descriptor.sectors / 2);
       if (m.distance <= o.max_descriptor_distance)
         scored.emplace_back(Pick{near[c].second, near[c].first, m, {}}, std::move(d));

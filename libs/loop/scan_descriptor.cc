@@ -99,17 +99,7 @@ DescriptorMatch BestShiftNear(const std::vector<double>& distances, int centre, 
 DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor& b) {
   const std::vector<double> distances = ShiftDistances(a, b);
   const int sectors = static_cast<int>(distances.size());
-  DescriptorMatch best;
-  best.distance = 2;
-  for (int shift = 0; shift < sectors; ++shift) {
-    if (distances[static_cast<size_t>(shift)] < best.distance) {  // First shift wins ties.
-      best.distance = distances[static_cast<size_t>(shift)];
-      best.shift = shift;
-    }
-  }
-  const int signed_shift = best.shift > sectors / 2 ? best.shift - sectors : best.shift;
-  best.yaw = 2 * kPi * signed_shift / sectors;
-  return best;
+  return BestShiftNear(distances, 0, sectors / 2);
 }
 
 double RingKeyDistance(const ScanDescriptor& a, const ScanDescriptor& b) {

@@ -38,7 +38,8 @@ struct DescriptorMatch {
 
 // The mean over the sector columns with returns in both of (1 - cosine similarity of the
 // columns), minimised over the column shifts of b. Columns empty in one of the two count as
-// dissimilar (1) unless empty in both; two empty descriptors are at distance 1.
+// dissimilar (1) unless empty in both; two empty descriptors are at distance 1. Ties go to the
+// shift nearest 0 (BestShiftNear).
 DescriptorMatch CompareDescriptors(const ScanDescriptor& a, const ScanDescriptor& b);
 // The same distance at every shift 0 .. sectors - 1.
 std::vector<double> ShiftDistances(const ScanDescriptor& a, const ScanDescriptor& b);
