@@ -51,18 +51,7 @@ Rigid3d Odometry::PredictMotion() const {
 RegistrationResult Odometry::Register(const ScanSurface& surface, const Rigid3d& predicted,
                                       const AssociationOptions& association,
                                       const RegistrationOptions& options, int* samples) const {
-  // IMLS-SLAM sampling: s points per list with a model neighbour within r at the prediction.
-  const SampledScan scan = SampleSurface(surface, association.samples_per_list);
-  const std::vector<int> picked = SelectSamples(scan, predicted, model_, association);
-  std::vector<Eigen::Vector3d> points;
-  std::vector<double> planarity;
-  points.reserve(picked.size());
-  for (const int i : picked) {
-    points.push_back(scan.points[i]);
-    planarity.push_back(scan.planarity[i]);
-  }
-  *samples = static_cast<int>(points.size());
-  return RegisterScan(points, model_, predicted, association, options, threads_, &planarity);
+  return RegisterSurface(surface, model_, predicted, association, options, threads_, samples);
 }
 
 RegistrationResult Odometry::Track(const ScanSurface& surface, const Rigid3d& predicted,
@@ -73,12 +62,8 @@ RegistrationResult Odometry::Track(const ScanSurface& surface, const Rigid3d& pr
     // on a quarter of the samples (the wide neighbourhoods make each query ~20x dearer).
     AssociationOptions coarse = options_.association;
     RegistrationOptions coarse_registration = options_.registration;
-    const double k = options_.initial_search_scale;
-    coarse.search_radius *= k;
-    coarse.kernel_h *= k;
-    coarse.max_distance *= k;
+    ScaleNeighbourhoods(options_.initial_search_scale, &coarse, &coarse_registration);
     coarse.samples_per_list = std::max(1, coarse.samples_per_list / 4);
-    coarse_registration.robust_scale *= k;
     const RegistrationResult first =
         Register(surface, predicted, coarse, coarse_registration, samples);
     if (first.ok) start = first.world_from_scan;

@@ -148,4 +148,28 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, cons
   return result;
 }
 
+RegistrationResult RegisterSurface(const ScanSurface& surface, const ImlsModel& model,
+                                   const Rigid3d& start, const AssociationOptions& association,
+                                   const RegistrationOptions& options, int threads, int* samples) {
+  const SampledScan scan = SampleSurface(surface, association.samples_per_list);
+  const std::vector<int> picked = SelectSamples(scan, start, model, association);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> planarity;
+  points.reserve(picked.size());
+  planarity.reserve(picked.size());
+  for (const int i : picked) {
+    points.push_back(scan.points[i]);
+    planarity.push_back(scan.planarity[i]);
+  }
+  if (samples) *samples = static_cast<int>(points.size());
+  return RegisterScan(points, model, start, association, options, threads, &planarity);
+}
+
+void ScaleNeighbourhoods(double k, AssociationOptions* association, RegistrationOptions* options) {
+  association->search_radius *= k;
+  association->kernel_h *= k;
+  association->max_distance *= k;
+  options->robust_scale *= k;
+}
+
 }  // namespace jvl::lidar

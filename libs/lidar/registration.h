@@ -17,6 +17,7 @@
 #include "geometry/rigid3.h"
 #include "lidar/association.h"
 #include "lidar/imls.h"
+#include "lidar/surface.h"
 
 namespace jvl::lidar {
 
@@ -49,5 +50,18 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, cons
                                 const Rigid3d& initial, const AssociationOptions& association,
                                 const RegistrationOptions& options, int threads,
                                 const std::vector<double>* planarity = nullptr);
+
+// IMLS-SLAM sampling and registration of a scan's surface on `model` from `start`: s points per
+// sampling list with a model neighbour within r at `start` (SampleSurface, SelectSamples), each
+// weighted by its planarity in the observability test. `samples` (optional) receives how many
+// points were registered.
+RegistrationResult RegisterSurface(const ScanSurface& surface, const ImlsModel& model,
+                                   const Rigid3d& start, const AssociationOptions& association,
+                                   const RegistrationOptions& options, int threads,
+                                   int* samples = nullptr);
+
+// The neighbourhoods of a coarse registration without a motion estimate: search radius,
+// kernel h, max distance and robust scale multiplied by k (samples per list unchanged).
+void ScaleNeighbourhoods(double k, AssociationOptions* association, RegistrationOptions* options);
 
 }  // namespace jvl::lidar

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <optional>
 
 #include "core/check.h"
@@ -61,29 +60,17 @@ namespace {
 // a coarse pass with scaled neighbourhoods, then the normal one (as lidar_odom's first pair).
 lidar::RegistrationResult Verify(const lidar::ScanSurface& query, const lidar::ScanSurface& match,
                                  const Rigid3d& initial, const LidarLoopOptions& o) {
-  const double k = o.coarse_scale;
   auto run = [&](const lidar::AssociationOptions& association,
                  const lidar::RegistrationOptions& registration, const Rigid3d& start) {
     lidar::ImlsModel model(association.search_radius);
     lidar::AddScanToModel(match.points, match.normals, Rigid3d(), 0, &model);
-    const lidar::SampledScan scan = lidar::SampleSurface(query, association.samples_per_list);
-    const std::vector<int> picked = lidar::SelectSamples(scan, start, model, association);
-    std::vector<Eigen::Vector3d> points;
-    std::vector<double> planarity;
-    for (const int i : picked) {
-      points.push_back(scan.points[i]);
-      planarity.push_back(scan.planarity[i]);
-    }
-    return lidar::RegisterScan(points, model, start, association, registration, 1, &planarity);
+    return lidar::RegisterSurface(query, model, start, association, registration, 1);
   };
   Rigid3d start = initial;
-  if (k > 1) {
+  if (o.coarse_scale > 1) {
     lidar::AssociationOptions coarse = o.association;
     lidar::RegistrationOptions coarse_registration = o.registration;
-    coarse.search_radius *= k;
-    coarse.kernel_h *= k;
-    coarse.max_distance *= k;
-    coarse_registration.robust_scale *= k;
+    lidar::ScaleNeighbourhoods(o.coarse_scale, &coarse, &coarse_registration);
     const lidar::RegistrationResult first = run(coarse, coarse_registration, initial);
     if (first.ok) start = first.world_from_scan;
   }

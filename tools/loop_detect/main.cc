@@ -45,7 +45,6 @@ Trajectory SelectKeyframes(const Trajectory& poses, const io::Dataset& dataset, 
 // 1 m and 2 deg of the true one.
 void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
                               double min_separation) {
-  std::vector<size_t> index;
   Trajectory kf;
   for (const int64_t f : loops.keyframes) {
     const auto i = gt.IndexOf(f);
