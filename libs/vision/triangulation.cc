@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -145,6 +146,82 @@ Eigen::Vector3d RefinePoint(const PinholeCamera& camera, const std::vector<Point
     if (dx.norm() < 1e-9 * (1.0 + x.norm())) break;
   }
   return x;
+}
+
+void PoseRefinementOptions::Check() const {
+  JVL_CHECK(rounds >= 1 && iterations >= 1, "pose refinement: rounds and iterations must be >= 1");
+  JVL_CHECK(chi2 > 0 && huber > 0, "pose refinement: chi2 and huber must be positive");
+  JVL_CHECK(center_sigma >= 0, "pose refinement: center_sigma must be >= 0");
+}
+
+PoseRefinement RefinePose(const PinholeCamera& camera,
+                          const std::vector<PointObservation>& observations,
+                          const Rigid3d& initial_cam_from_world,
+                          const PoseRefinementOptions& options,
+                          const Eigen::Vector3d& center_prior) {
+  options.Check();
+  PoseRefinement out;
+  out.cam_from_world = initial_cam_from_world;
+  const size_t n = observations.size();
+  out.inlier.assign(n, 1);
+  // Squared whitened error at a pose (infinity behind the camera).
+  const auto whitened2 = [&](const Rigid3d& t, const PointObservation& o) {
+    return SquaredReprojectionError(camera, t, o.point_world, o.uv) /
+           (o.level_scale * o.level_scale);
+  };
+  bool well_conditioned = false;
+  for (int round = 0; round < options.rounds; ++round) {
+    well_conditioned = false;
+    for (int it = 0; it < options.iterations; ++it) {
+      Eigen::Matrix<double, 6, 6> h = Eigen::Matrix<double, 6, 6>::Zero();
+      Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+      int used = 0;
+      for (size_t i = 0; i < n; ++i) {
+        if (!out.inlier[i]) continue;
+        const PointObservation& o = observations[i];
+        const Eigen::Vector3d p = out.cam_from_world * o.point_world;
+        if (p.z() <= 1e-6) continue;
+        const Eigen::Vector2d e = camera.Project(p) - o.uv;
+        const double iz = 1.0 / p.z();
+        Eigen::Matrix<double, 2, 3> j_proj;
+        j_proj << camera.fx * iz, 0, -camera.fx * p.x() * iz * iz, 0, camera.fy * iz,
+            -camera.fy * p.y() * iz * iz;
+        // Left perturbation of cam_from_world: p' = p + rho + omega x p.
+        Eigen::Matrix<double, 3, 6> j_pose;
+        j_pose.leftCols<3>().setIdentity();
+        j_pose.rightCols<3>() = -Skew(p);
+        const Eigen::Matrix<double, 2, 6> j = j_proj * j_pose;
+        const double info = 1.0 / (o.level_scale * o.level_scale);
+        const double norm = std::sqrt(e.squaredNorm() * info);
+        const double w = info * (norm <= options.huber ? 1.0 : options.huber / norm);
+        h += w * j.transpose() * j;
+        g += w * j.transpose() * e;
+        ++used;
+      }
+      if (used < 6) break;
+      if (options.center_sigma > 0) {
+        // Camera centre c = -R^T t; under the left perturbation dc = -R^T rho.
+        const Eigen::Matrix3d r = out.cam_from_world.RotationMatrix();
+        const Eigen::Vector3d c = -(r.transpose() * out.cam_from_world.translation());
+        const double info = 1.0 / (options.center_sigma * options.center_sigma);
+        h.topLeftCorner<3, 3>() += info * Eigen::Matrix3d::Identity();
+        g.head<3>() += info * (-r * (c - center_prior));
+      }
+      const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(h);
+      if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-9)) break;
+      const Eigen::Matrix<double, 6, 1> dx = -ldlt.solve(g);
+      if (!dx.allFinite()) break;
+      well_conditioned = true;
+      out.cam_from_world = Rigid3d(ExpSO3(dx.tail<3>()), dx.head<3>()) * out.cam_from_world;
+      if (dx.norm() < 1e-10) break;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      out.inlier[i] = whitened2(out.cam_from_world, observations[i]) <= options.chi2 ? 1 : 0;
+    }
+  }
+  out.inliers = static_cast<int>(std::count(out.inlier.begin(), out.inlier.end(), 1));
+  out.ok = well_conditioned && out.inliers >= 6;
+  return out;
 }
 
 }  // namespace jvl::vision

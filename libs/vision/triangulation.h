@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -71,5 +72,40 @@ double SquaredReprojectionError(const PinholeCamera& camera, const Rigid3d& cam_
 Eigen::Vector3d RefinePoint(const PinholeCamera& camera, const std::vector<PointView>& views,
                             const Eigen::Vector3d& initial, int iterations = 5,
                             double huber_px = 2.0);
+
+// One 3D-2D correspondence of a motion-only pose estimate.
+struct PointObservation {
+  Eigen::Vector3d point_world;
+  Eigen::Vector2d uv;
+  double level_scale = 1.0;  // sigma = level_scale px.
+};
+
+struct PoseRefinementOptions {
+  int rounds = 4;                 // Outlier classification rounds (ORB-SLAM2's PoseOptimization).
+  int iterations = 10;            // Gauss-Newton iterations per round.
+  double chi2 = 5.991;            // Inlier bound on the squared error x 1 / level variance.
+  double huber = 2.447746830680;  // sqrt(chi2(2, 0.95)): Huber threshold of the whitened error.
+  // > 0: a Gaussian prior (sigma in m per axis) ties the camera centre to RefinePose's
+  // `center_prior` (a monocular estimate fixes the scale along the motion poorly).
+  double center_sigma = 0.0;
+  void Check() const;
+};
+
+struct PoseRefinement {
+  Rigid3d cam_from_world;
+  std::vector<uint8_t> inlier;  // Per observation, at the final pose.
+  int inliers = 0;
+  bool ok = false;  // At least 6 inliers and a well-conditioned system in the last round.
+};
+
+// Motion-only refinement of a camera pose from 3D-2D matches with the points held fixed:
+// Gauss-Newton on the Huber-weighted, level-whitened reprojection errors, in rounds; after each
+// round an observation beyond chi2 is left out of the next one (and may return when the pose
+// moves), as in ORB-SLAM2's PoseOptimization (Mur-Artal and Tardos 2017).
+PoseRefinement RefinePose(const PinholeCamera& camera,
+                          const std::vector<PointObservation>& observations,
+                          const Rigid3d& initial_cam_from_world,
+                          const PoseRefinementOptions& options = {},
+                          const Eigen::Vector3d& center_prior = Eigen::Vector3d::Zero());
 
 }  // namespace jvl::vision

@@ -105,5 +105,77 @@ TEST(Triangulation, RefinePointReducesErrorFromNoisyStart) {
   EXPECT_LT(std::sqrt(after / views.size()), 1.0);
 }
 
+// Points spread over a street-like volume in front of a camera at `cam_from_world`.
+std::vector<PointObservation> StreetObservations(const PinholeCamera& cam,
+                                                 const Rigid3d& cam_from_world, double noise_px,
+                                                 int outliers, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> lateral(-12, 12), height(-1.7, 6), depth(4, 60);
+  std::normal_distribution<double> noise(0.0, noise_px);
+  std::uniform_real_distribution<double> pixel(-40, 40);
+  std::vector<PointObservation> obs;
+  const Rigid3d world_from_cam = cam_from_world.Inverse();
+  while (obs.size() < 300) {
+    const Eigen::Vector3d x =
+        world_from_cam * Eigen::Vector3d(lateral(rng), height(rng), depth(rng));
+    const Eigen::Vector2d uv = cam.Project(cam_from_world * x);
+    if (uv.x() < 0 || uv.y() < 0 || uv.x() > cam.width || uv.y() > cam.height) continue;
+    obs.push_back({x, uv + Eigen::Vector2d(noise(rng), noise(rng)), 1.0});
+  }
+  for (int i = 0; i < outliers; ++i)
+    obs[static_cast<size_t>(i) * 3].uv += Eigen::Vector2d(pixel(rng), 25);
+  return obs;
+}
+
+double AngleDeg(const Rigid3d& a, const Rigid3d& b) {
+  return RotationAngle((a * b.Inverse()).rotation()) * 180.0 / M_PI;
+}
+
+TEST(RefinePose, RecoversAPerturbedPoseAndFlagsOutliers) {
+  const PinholeCamera cam = KittiCamera();
+  const Rigid3d truth =
+      Rigid3d(ExpSO3(Eigen::Vector3d(0.01, 0.3, -0.02)), Eigen::Vector3d(4.0, -1.2, 25.0))
+          .Inverse();
+  const std::vector<PointObservation> obs = StreetObservations(cam, truth, 0.5, 30, 3);
+  // A prior glitch: 0.8 deg of heading and 0.3 m sideways.
+  const Rigid3d start =
+      Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.014, 0)), Eigen::Vector3d(0.3, 0, 0)) * truth;
+  const PoseRefinement r = RefinePose(cam, obs, start);
+  ASSERT_TRUE(r.ok);
+  EXPECT_LT(AngleDeg(r.cam_from_world, truth), 0.02);
+  EXPECT_LT((r.cam_from_world.Inverse().translation() - truth.Inverse().translation()).norm(),
+            0.05);
+  // The 30 displaced observations are the outliers (a few true ones may fall beyond chi2 too).
+  int flagged = 0;
+  for (int i = 0; i < 30; ++i) flagged += r.inlier[static_cast<size_t>(i) * 3] ? 0 : 1;
+  EXPECT_EQ(flagged, 30);
+  EXPECT_GE(r.inliers, 300 - 30 - 15);
+}
+
+TEST(RefinePose, CenterPriorHoldsTheCentreWhereTheImageCannot) {
+  const PinholeCamera cam = KittiCamera();
+  const Rigid3d truth =
+      Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.1, 0)), Eigen::Vector3d(1, 0, 3)).Inverse();
+  const std::vector<PointObservation> obs = StreetObservations(cam, truth, 0.0, 0, 5);
+  const Eigen::Vector3d center = truth.Inverse().translation();
+  // Exact observations, but the prior puts the centre 0.2 m off: with a tight sigma the
+  // estimate follows the prior, without one it follows the image.
+  const Eigen::Vector3d off = center + Eigen::Vector3d(0.2, 0, 0);
+  PoseRefinementOptions tight;
+  tight.center_sigma = 1e-4;
+  const PoseRefinement held = RefinePose(cam, obs, truth, tight, off);
+  EXPECT_LT((held.cam_from_world.Inverse().translation() - off).norm(), 0.01);
+  const PoseRefinement free = RefinePose(cam, obs, truth, {}, off);
+  EXPECT_LT((free.cam_from_world.Inverse().translation() - center).norm(), 1e-6);
+  EXPECT_LT(AngleDeg(free.cam_from_world, truth), 1e-6);
+}
+
+TEST(RefinePose, TooFewObservationsAreNotOk) {
+  const PinholeCamera cam = KittiCamera();
+  std::vector<PointObservation> obs = StreetObservations(cam, Rigid3d(), 0.5, 0, 9);
+  obs.resize(5);
+  EXPECT_FALSE(RefinePose(cam, obs, Rigid3d()).ok);
+}
+
 }  // namespace
 }  // namespace jvl::vision

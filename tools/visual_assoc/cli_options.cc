@@ -59,6 +59,22 @@ void AddVisualMapFlags(app::Tool& tool, mapping::VisualMapOptions* o) {
              "Pull of the warp towards the predicted scale");
   method.Add("--refine-on-insert", o->refine_on_insert,
              "Refine points and drop outlier observations as keyframes are added");
+  method.Add("--track-pose", o->track_pose,
+             "Refine each frame's pose from its matches where the prior's motion disagrees with "
+             "them (a registration glitch); false: the prior's pose");
+  method.Add("--track-min-inliers", o->track_min_inliers,
+             "Inliers a refined pose needs to be used");
+  method.Add(
+      "--track-min-rotation", o->track_min_rotation_deg,
+      "A refinement replaces the prediction only if it turns it by more than this (deg) ...");
+  method.Add("--track-min-translation", o->track_min_translation_m,
+             "... or moves its camera centre by more than this (m)");
+  method.Add("--track-max-rotation", o->track_max_rotation_deg,
+             "Largest rotation (deg) a refinement may apply to the prediction");
+  method.Add("--track-max-translation", o->track_max_translation_m,
+             "Largest camera centre shift (m) a refinement may apply to the prediction");
+  method.Add("--track-center-sigma", o->pose.center_sigma,
+             "Sigma (m) tying the refined camera centre to the prediction (0: free)");
 }
 
 }  // namespace jvl::tools

@@ -52,9 +52,13 @@ int main(int argc, char** argv) {
         [&](const mapping::FrameReport& r) {
           spdlog::debug(
               "frame {}: {} keypoints, tracked {}/{}, keyframe {} ({}), new {}, fused {}, "
-              "culled {}, {:.1f} ms",
+              "culled {}, pose {} ({} inliers, {} predicted, correction {:.4f} deg {:.4f} m; "
+              "{:.3f} deg / {:.3f} "
+              "m from the prior), {:.1f} ms",
               r.frame, r.keypoints, r.tracked, r.candidates, r.keyframe,
-              mapping::ToString(r.reason), r.new_points, r.fused, r.culled, r.ms);
+              mapping::ToString(r.reason), r.new_points, r.fused, r.culled,
+              r.pose_refined ? "refined" : "predicted", r.pose_inliers, r.predicted_inliers,
+              r.correction_deg, r.correction_m, r.pose_change_deg, r.pose_change_m, r.ms);
           progress.Tick();
         });
     io::VisualMapData data =

@@ -1,7 +1,9 @@
 #include "mapping/visual/map_builder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <utility>
 
 #include "core/check.h"
 #include "core/threads.h"
@@ -25,6 +27,12 @@ void VisualMapOptions::Check() const {
   JVL_CHECK(max_final_chi2 > 0, "visual map: max_final_chi2 must be > 0");
   JVL_CHECK(track_chi2 >= 0, "visual map: track_chi2 must be >= 0");
   JVL_CHECK(min_covisibility_weight >= 1, "visual map: min_covisibility_weight must be >= 1");
+  JVL_CHECK(track_min_inliers >= 6, "visual map: track_min_inliers must be >= 6");
+  JVL_CHECK(track_min_rotation_deg >= 0 && track_min_translation_m >= 0,
+            "visual map: track_min_rotation_deg and track_min_translation_m must be >= 0");
+  JVL_CHECK(track_max_rotation_deg > 0 && track_max_translation_m > 0,
+            "visual map: track_max_rotation_deg and track_max_translation_m must be positive");
+  pose.Check();
 }
 
 VisualMapBuilder::VisualMapBuilder(const PinholeCamera& camera, const VisualMapOptions& options)
@@ -50,34 +58,84 @@ std::vector<int> VisualMapBuilder::LocalPoints() const {
   return points;
 }
 
-// Tracking with the prior pose: the local map points matched by projection. Returns, per keypoint,
-// the matched map point or -1.
-std::vector<int> VisualMapBuilder::Track(const vision::OrbFeatures& features,
-                                         const Rigid3d& cam_from_world, FrameReport* report) {
-  std::vector<int> predicted;
+std::vector<std::pair<int, int>> VisualMapBuilder::MatchAt(const vision::OrbFeatures& features,
+                                                           const vision::KeypointGrid& grid,
+                                                           const std::vector<int>& local,
+                                                           const Rigid3d& cam_from_world,
+                                                           std::vector<int>* predicted) const {
+  predicted->clear();
   const auto projected =
-      PredictInView(map_, LocalPoints(), cam_from_world, options_.min_view_cos, &predicted);
-  const vision::KeypointGrid grid(features.keypoints, map_.camera.width, map_.camera.height);
+      PredictInView(map_, local, cam_from_world, options_.min_view_cos, predicted);
   const std::vector<int> match =
       vision::MatchByProjection(projected, features, grid, map_.level_scales, options_.projection);
-  std::vector<int> keypoint_point(features.size(), -1);
+  std::vector<std::pair<int, int>> out;
   for (size_t i = 0; i < match.size(); ++i) {
-    MapPoint& p = map_.points[predicted[i]];
-    ++p.visible;
-    if (match[i] < 0) continue;
+    if (match[i] >= 0) out.emplace_back((*predicted)[i], match[i]);
+  }
+  return out;
+}
+
+// Tracking: the local map points matched by projection at the predicted pose; with track_pose
+// the pose is refined from those matches and the points are matched again there.
+std::vector<int> VisualMapBuilder::Track(const vision::OrbFeatures& features,
+                                         Rigid3d* cam_from_world, FrameReport* report) {
+  const std::vector<int> local = LocalPoints();
+  const vision::KeypointGrid grid(features.keypoints, map_.camera.width, map_.camera.height);
+  std::vector<int> predicted;
+  std::vector<std::pair<int, int>> matches =
+      MatchAt(features, grid, local, *cam_from_world, &predicted);
+  if (options_.track_pose) {
+    std::vector<vision::PointObservation> obs;
+    for (const auto& [p, k] : matches) {
+      const vision::OrbKeypoint& kp = features.keypoints[k];
+      obs.push_back({map_.points[p].position, kp.uv.cast<double>(), map_.level_scales[kp.octave]});
+    }
+    const Rigid3d predicted_pose = *cam_from_world;
+    const Eigen::Vector3d center = predicted_pose.Inverse().translation();
+    const vision::PoseRefinement r =
+        vision::RefinePose(map_.camera, obs, predicted_pose, options_.pose, center);
+    const Rigid3d change = r.cam_from_world * predicted_pose.Inverse();
+    const bool small =
+        RotationAngle(change.rotation()) * 180.0 / M_PI <= options_.track_max_rotation_deg &&
+        (r.cam_from_world.Inverse().translation() - center).norm() <=
+            options_.track_max_translation_m;
+    report->pose_inliers = r.inliers;
+    for (const vision::PointObservation& o : obs) {
+      const double s2 = o.level_scale * o.level_scale;
+      if (vision::SquaredReprojectionError(map_.camera, predicted_pose, o.point_world, o.uv) <=
+          options_.pose.chi2 * s2) {
+        ++report->predicted_inliers;
+      }
+    }
+    report->correction_deg = RotationAngle(change.rotation()) * 180.0 / M_PI;
+    report->correction_m = (r.cam_from_world.Inverse().translation() - center).norm();
+    const bool disagree = report->correction_deg > options_.track_min_rotation_deg ||
+                          report->correction_m > options_.track_min_translation_m;
+    const bool explains_more =
+        r.inliers >= options_.track_min_inlier_gain * report->predicted_inliers;
+    if (r.ok && r.inliers >= options_.track_min_inliers && small && disagree && explains_more) {
+      *cam_from_world = r.cam_from_world;
+      report->pose_refined = true;
+      matches = MatchAt(features, grid, local, *cam_from_world, &predicted);
+    }
+  }
+  for (const int p : predicted) ++map_.points[p].visible;
+  std::vector<int> keypoint_point(features.size(), -1);
+  for (const auto& [point, keypoint] : matches) {
+    MapPoint& p = map_.points[point];
     if (options_.track_chi2 > 0) {
-      const vision::OrbKeypoint& kp = features.keypoints[match[i]];
+      const vision::OrbKeypoint& kp = features.keypoints[keypoint];
       const double s = map_.level_scales[kp.octave];
-      if (vision::SquaredReprojectionError(map_.camera, cam_from_world, p.position,
+      if (vision::SquaredReprojectionError(map_.camera, *cam_from_world, p.position,
                                            kp.uv.cast<double>()) > options_.track_chi2 * s * s) {
         continue;
       }
     }
     ++p.found;
-    keypoint_point[match[i]] = predicted[i];
+    keypoint_point[keypoint] = point;
     ++report->tracked;
   }
-  report->candidates = static_cast<int>(projected.size());
+  report->candidates = static_cast<int>(predicted.size());
   return keypoint_point;
 }
 
@@ -110,10 +168,25 @@ FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_
   FrameReport report;
   report.frame = frame;
   report.keypoints = static_cast<int>(features.size());
-  const Rigid3d cam_from_world = world_from_cam.Inverse();
+  // The pose: the previous frame's pose moved by the prior's motion since then (the prior
+  // itself while no frame was refined), refined by tracking.
+  Rigid3d pose = world_from_cam;
+  if (!first_ && options_.track_pose && corrected_) {
+    pose = last_pose_ * (last_prior_.Inverse() * world_from_cam);
+  }
+  Rigid3d cam_from_world = pose.Inverse();
   ++frames_since_keyframe_;
   std::vector<int> keypoint_point(features.size(), -1);
-  if (!first_) keypoint_point = Track(features, cam_from_world, &report);
+  if (!first_) keypoint_point = Track(features, &cam_from_world, &report);
+  if (report.pose_refined) {
+    pose = cam_from_world.Inverse();
+    corrected_ = true;
+  }
+  const Rigid3d change = world_from_cam.Inverse() * pose;
+  report.pose_change_deg = RotationAngle(change.rotation()) * 180.0 / M_PI;
+  report.pose_change_m = change.translation().norm();
+  last_prior_ = world_from_cam;
+  last_pose_ = pose;
 
   KeyframeRuleInput input;
   input.first_frame = first_;
@@ -128,7 +201,7 @@ FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_
   if (decision.keyframe) {
     Keyframe kf;
     kf.frame = frame;
-    kf.world_from_cam = world_from_cam;
+    kf.world_from_cam = pose;
     kf.cam_from_world = cam_from_world;
     kf.mappoint.assign(features.size(), -1);
     kf.features = std::move(features);
@@ -212,6 +285,7 @@ VisualMapResult BuildVisualMap(const PinholeCamera& camera, const Trajectory& po
   std::vector<int64_t> directions = direction_frames;
   std::sort(directions.begin(), directions.end());
   VisualMapResult result;
+  result.track_pose = options.track_pose;
   std::unique_ptr<VisualMapBuilder> builder;
   const int64_t n = static_cast<int64_t>(poses.size());
   const int64_t batch = std::max(1, threads) * 2;

@@ -1,5 +1,7 @@
-// Builds the visual map of Sec. 4.1 from ORB features and prior poses. Unlike ORB-SLAM2 there is
-// no motion-only bundle adjustment: each frame's pose is the prior, and it is used to
+// Builds the visual map of Sec. 4.1 from ORB features and prior poses. Each frame's pose is
+// predicted from the prior's motion since the previous frame and, with track_pose (beyond the
+// paper: the prior's registration glitches would otherwise break the tracks), refined by a
+// motion-only estimate on the matched map points as ORB-SLAM2's tracking does; it is used to
 //  1. match the points of the local map by projection (tracking),
 //  2. decide whether the frame is a keyframe (keyframe_rule.h, incl. direction frames),
 //  3. for keyframes: add the tracked observations, triangulate new points against the most recent
@@ -55,6 +57,24 @@ struct VisualMapOptions {
   bool require_alignment = true;
   vision::PatchAlignOptions align;
   int min_covisibility_weight = 15;  // Edges kept in the artifact (ORB-SLAM2 threshold).
+  // Pose tracking (docs/visual_assoc.md "Pose tracking"): a frame's pose is predicted as the
+  // previous frame's pose times the prior's motion between the two, and refined from the
+  // projection matches (vision::RefinePose, the camera centre tied to the prediction by
+  // pose.center_sigma). The refined pose replaces the prediction only where the two disagree by
+  // more than the refinement's own noise on a correct prior (track_min_rotation_deg or
+  // track_min_translation_m: the prior has a registration glitch there), within
+  // track_max_rotation_deg / track_max_translation_m, with at least track_min_inliers inliers;
+  // the points are then matched again at the refined pose. Elsewhere the prior's motion is kept:
+  // it is locally far more precise than a monocular estimate. false: every frame takes the
+  // prior's pose (the paper).
+  bool track_pose = false;
+  int track_min_inliers = 40;
+  double track_min_inlier_gain = 1.2;
+  double track_min_rotation_deg = 0.15;
+  double track_min_translation_m = 0.1;
+  double track_max_rotation_deg = 3.0;
+  double track_max_translation_m = 1.0;
+  vision::PoseRefinementOptions pose{4, 10, 5.991, 2.447746830680, 0.05};
   void Check() const;
 };
 
@@ -69,7 +89,11 @@ struct FrameReport {
   int new_points = 0;  // Triangulated (keyframes only).
   int fused = 0;       // Extra observations of new points in neighbour keyframes.
   int culled = 0;
-  double ms = 0;  // Association time (excluding ORB extraction).
+  bool pose_refined = false;                      // track_pose: the refinement was used.
+  int pose_inliers = 0, predicted_inliers = 0;    // Matches within pose.chi2: refined / predicted.
+  double correction_deg = 0, correction_m = 0;    // Refined pose against the prediction.
+  double pose_change_deg = 0, pose_change_m = 0;  // Pose used against the prior's (this frame).
+  double ms = 0;                                  // Association time (excluding ORB extraction).
 };
 
 class VisualMapBuilder {
@@ -84,8 +108,16 @@ class VisualMapBuilder {
 
  private:
   std::vector<int> LocalPoints() const;
-  std::vector<int> Track(const vision::OrbFeatures& features, const Rigid3d& cam_from_world,
+  // Matches the local points at *cam_from_world (refined there with track_pose); per keypoint
+  // the map point or -1.
+  std::vector<int> Track(const vision::OrbFeatures& features, Rigid3d* cam_from_world,
                          FrameReport* report);
+  // Projection matches at a pose: (point, keypoint) pairs and the points predicted in view.
+  std::vector<std::pair<int, int>> MatchAt(const vision::OrbFeatures& features,
+                                           const vision::KeypointGrid& grid,
+                                           const std::vector<int>& local,
+                                           const Rigid3d& cam_from_world,
+                                           std::vector<int>* predicted) const;
   int ReferenceTracked(const std::vector<int>& match) const;
   int CreateNewPoints(int keyframe);                                 // map_points.cc
   int FusePoints(int keyframe, const std::vector<int>& new_points);  // map_points.cc
@@ -105,6 +137,8 @@ class VisualMapBuilder {
   VisualMap map_;
   std::vector<int> recent_points_;  // Created within the last keyframes; subject to culling.
   int64_t last_frame_ = -1;
+  Rigid3d last_prior_, last_pose_;  // world_from_cam of the previous frame: prior / used.
+  bool corrected_ = false;          // A refinement has moved the poses off the prior.
   int frames_since_keyframe_ = 0;
   bool first_ = true;
 };
@@ -117,6 +151,7 @@ struct VisualMapResult {
   VisualMap map;
   std::vector<FrameReport> frames;
   std::vector<double> orb_ms;  // Per frame ORB extraction time.
+  bool track_pose = false;     // VisualMapOptions::track_pose of the run.
 };
 VisualMapResult BuildVisualMap(const PinholeCamera& camera, const Trajectory& poses,
                                const std::vector<int64_t>& direction_frames,

@@ -143,6 +143,62 @@ TEST(VisualMapBuilder, SyntheticCorridorWithKnownPoses) {
   for (int w : data.covisibility_weight) EXPECT_GE(w, 15);
 }
 
+// Heading error (deg) of a pose against the truth.
+double HeadingErrorDeg(const Rigid3d& pose, const Rigid3d& truth) {
+  return RotationAngle((truth.Inverse() * pose).rotation()) * 180.0 / M_PI;
+}
+
+// Every frame a keyframe (direction frames), so the map keeps the pose used for each frame.
+VisualMap BuildAll(const Corridor& scene, const Trajectory& prior, const VisualMapOptions& options,
+                   std::vector<FrameReport>* reports) {
+  VisualMapBuilder builder(KittiCamera(), options);
+  std::vector<int> truth;
+  for (size_t f = 0; f < prior.size(); ++f) {
+    reports->push_back(builder.AddFrame(prior.frames[f], prior.world_from_cam[f],
+                                        scene.View(static_cast<int>(f), &truth), true));
+  }
+  return builder.Finish();
+}
+
+TEST(VisualMapBuilder, PoseTrackingRepairsAPriorGlitchAndLeavesAGoodPriorAlone) {
+  const int frames = 20;
+  const Corridor scene(frames);
+  VisualMapOptions options;
+  options.track_pose = true;
+  // A correct prior: no refinement replaces it, the map is built at the prior's poses exactly.
+  std::vector<FrameReport> reports;
+  const VisualMap good = BuildAll(scene, scene.poses(), options, &reports);
+  for (const FrameReport& r : reports) EXPECT_FALSE(r.pose_refined) << "frame " << r.frame;
+  for (const Keyframe& kf : good.keyframes) {
+    EXPECT_EQ(kf.world_from_cam.ToArray(), scene.poses().world_from_cam[kf.frame].ToArray());
+  }
+  // A registration glitch: frames 12-14 turned by 0.8 deg about the vertical, then back.
+  Trajectory glitched = scene.poses();
+  for (int f = 12; f <= 14; ++f) {
+    glitched.world_from_cam[f] =
+        glitched.world_from_cam[f] *
+        Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.8 * M_PI / 180, 0)), Eigen::Vector3d::Zero());
+  }
+  reports.clear();
+  const VisualMap repaired = BuildAll(scene, glitched, options, &reports);
+  reports.clear();
+  options.track_pose = false;
+  const VisualMap kept = BuildAll(scene, glitched, options, &reports);
+  for (int f = 12; f <= 14; ++f) {
+    EXPECT_NEAR(HeadingErrorDeg(kept.keyframes[f].world_from_cam, scene.poses().world_from_cam[f]),
+                0.8, 1e-9);
+    EXPECT_LT(
+        HeadingErrorDeg(repaired.keyframes[f].world_from_cam, scene.poses().world_from_cam[f]), 0.1)
+        << "frame " << f;
+  }
+  // After the glitch the prior's motion is right again, and the repaired frames stay on it.
+  for (int f = 15; f < frames; ++f) {
+    EXPECT_LT(
+        HeadingErrorDeg(repaired.keyframes[f].world_from_cam, scene.poses().world_from_cam[f]), 0.1)
+        << "frame " << f;
+  }
+}
+
 TEST(VisualMapBuilder, RejectsFramesOutOfOrder) {
   const Corridor scene(3);
   VisualMapBuilder builder(KittiCamera(), VisualMapOptions());

@@ -33,9 +33,13 @@ Trajectory SelectPriorPoses(const Trajectory& prior, const std::vector<int64_t>&
 
 nlohmann::json Summarize(const VisualMapResult& result, const VisualMapStats& stats) {
   std::map<std::string, int> reasons;
-  std::vector<double> total_ms, assoc_ms;
+  std::vector<double> total_ms, assoc_ms, change_deg, change_m;
+  int refined = 0;
   for (size_t i = 0; i < result.frames.size(); ++i) {
     const FrameReport& f = result.frames[i];
+    refined += f.pose_refined ? 1 : 0;
+    change_deg.push_back(f.pose_change_deg);
+    change_m.push_back(f.pose_change_m);
     if (f.keyframe) ++reasons[ToString(f.reason)];
     assoc_ms.push_back(f.ms);
     total_ms.push_back(f.ms + (i < result.orb_ms.size() ? result.orb_ms[i] : 0.0));
@@ -55,6 +59,15 @@ nlohmann::json Summarize(const VisualMapResult& result, const VisualMapStats& st
   j["median_frame_ms"] = MedianOrZero(total_ms);
   j["median_association_ms"] = MedianOrZero(assoc_ms);
   j["median_orb_ms"] = MedianOrZero(result.orb_ms);
+  if (result.track_pose) {  // Pose tracking: how far the poses used are from the prior's.
+    j["pose_refined_frames"] = refined;
+    j["median_pose_change_deg"] = MedianOrZero(change_deg);
+    j["max_pose_change_deg"] =
+        change_deg.empty() ? 0.0 : *std::max_element(change_deg.begin(), change_deg.end());
+    j["median_pose_change_m"] = MedianOrZero(change_m);
+    j["max_pose_change_m"] =
+        change_m.empty() ? 0.0 : *std::max_element(change_m.begin(), change_m.end());
+  }
   return j;
 }
 

@@ -26,7 +26,6 @@ struct VisualMapStats {
 };
 VisualMapStats ComputeStats(const io::VisualMapData& data);
 
-
 // The prior poses of `frames` (every frame must be in the prior; throws naming the first missing
 // frame and `what`).
 Trajectory SelectPriorPoses(const Trajectory& prior, const std::vector<int64_t>& frames,

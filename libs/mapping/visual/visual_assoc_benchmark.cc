@@ -19,7 +19,6 @@ namespace {
 const std::string kRoot =
     std::string(JVL_BENCH_SOURCE_DIR) + "/../shared/data/kitti_odometry_04_f0-50";
 
-
 void BM_ExtractOrb(benchmark::State& state) {
   const cv::Mat image =
       cv::imread(kRoot + "/sequences/04/image_0/000000.png", cv::IMREAD_GRAYSCALE);
