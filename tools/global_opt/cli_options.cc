@@ -55,6 +55,7 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
              "Vertical prior: half window (frames) of the low-frequency disagreement");
   method.Add("--vertical-sigma", o->vertical_sigma_deg,
              "Vertical prior: its sigma in degrees as given (0: from --vertical-bias)");
+  method.Flag("!--no-loops", o->use_loops, "Leave out the loops of --loops (ablation)");
   method.Flag("!--no-odometry", o->use_odometry,
               "Leave out the odometry term e_O (the paper's energy; ablation)");
   method.Add("--odometry-gate", o->odometry_gate,

@@ -3,12 +3,18 @@
 // with other weights needs neither the dataset nor a new feature association.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cstdlib>
+#include <iterator>
+#include <optional>
+
 #include "app/tool.h"
 #include "cli_options.h"
 #include "core/check.h"
 #include "core/memory.h"
 #include "core/timer.h"
 #include "io/global_io.h"
+#include "io/loops_io.h"
 #include "io/ply_io.h"
 #include "io/trajectory_io.h"
 #include "io/vps_io.h"
@@ -22,7 +28,7 @@ int main(int argc, char** argv) {
                  "Global joint optimisation: visual reprojection + point-to-IMLS + direction "
                  "projection errors over all keyframes (Eq. 7), full-rate trajectory and map.");
   std::string local_path, visual_path, directions_path, vps_path, prior_path, odometry_path, output,
-      kitti, map_path;
+      kitti, map_path, loops_path;
   double map_voxel = 0.2;
   bool map_ascii = false;
   mapping::GlobalMappingOptions o;  // the library's defaults are the tool's
@@ -45,6 +51,11 @@ int main(int argc, char** argv) {
       "weighted (.h5 artifact, KITTI, TUM; default: the prior). In a re-association pass, "
       "pass the chain's first prior (lidar_odom) here: its motion is locally smoother than a "
       "global result's"));
+  tool.InputFile(cli.add_option(
+      "--loops", loops_path,
+      "loops artifact (loop_detect): its accepted loops correct the keyframes before the "
+      "optimisation (Algorithm 1) and tie each loop's query scan to the scans around its match "
+      "(--no-loops leaves them out)"));
   tool.OutputFile(cli.add_option("-o,--output", output, "global artifact to write")->required());
   tool.OutputFile(
       cli.add_option("--kitti-poses", kitti, "Full-rate trajectory as KITTI poses text"));
@@ -103,6 +114,51 @@ int main(int argc, char** argv) {
       input = mapping::AssembleGlobalInput(visual, std::move(local),
                                            directions_path.empty() ? nullptr : &directions);
       if (o.use_odometry) input.odometry = std::move(odometry);
+      if (!loops_path.empty()) {
+        tool.AddInput(loops_path);
+        // A loop end that is not a keyframe moves to the nearest keyframe within
+        // kLoopSnapFrames frames; the prior's motion between the two carries the relative pose.
+        constexpr int64_t kLoopSnapFrames = 5;
+        const auto nearest = [&](int64_t frame) -> std::optional<size_t> {
+          const auto& f = input.keyframes.frames;
+          const auto it = std::lower_bound(f.begin(), f.end(), frame);
+          std::optional<size_t> best;
+          for (auto c = it == f.begin() ? it : std::prev(it); c != f.end() && c <= it; ++c) {
+            if (std::abs(*c - frame) > kLoopSnapFrames) continue;
+            if (!best || std::abs(*c - frame) < std::abs(f[*best] - frame))
+              best = static_cast<size_t>(c - f.begin());
+          }
+          return best;
+        };
+        int64_t accepted = 0, unplaced = 0;
+        for (const io::LoopRecord& r : io::ReadLoopsArtifact(loops_path).loops) {
+          if (r.status != 0) continue;
+          ++accepted;
+          const auto q = nearest(r.query), m = nearest(r.match);
+          const auto pq = prior.IndexOf(r.query), pm = prior.IndexOf(r.match);
+          if (!q || !m || !pq || !pm || *m >= *q) {
+            ++unplaced;
+            continue;
+          }
+          const auto pq2 = prior.IndexOf(input.keyframes.frames[*q]);
+          const auto pm2 = prior.IndexOf(input.keyframes.frames[*m]);
+          if (!pq2 || !pm2) {
+            ++unplaced;
+            continue;
+          }
+          const auto& w = prior.world_from_cam;
+          const Rigid3d rel =
+              w[*pm2].Inverse() * w[*pm] * r.match_from_query * w[*pq].Inverse() * w[*pq2];
+          input.loops.push_back({static_cast<int64_t>(*q), static_cast<int64_t>(*m), rel});
+        }
+        if (unplaced > 0) {
+          spdlog::warn(
+              "{}: {} of {} accepted loops have an end more than {} frames from a keyframe of "
+              "{} or outside the prior (left out)",
+              loops_path, unplaced, accepted, kLoopSnapFrames, local_path);
+        }
+        if (o.use_loops) spdlog::info("{}: {} loops", loops_path, input.loops.size());
+      }
       if (!vps_path.empty() && !flags.no_direction && o.use_vertical) {
         tool.AddInput(vps_path);
         for (const io::VpRecord& v : io::ReadVpsArtifact(vps_path).vps)

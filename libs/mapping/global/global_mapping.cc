@@ -19,6 +19,7 @@
 #include "lidar/imls.h"
 #include "lidar/surface.h"
 #include "lidar/voxel_grid.h"
+#include "optim/correction.h"
 #include "optim/cost_functions.h"
 #include "optim/pose_block.h"
 
@@ -46,6 +47,46 @@ void GlobalMapInput::Check() const {
     JVL_CHECK(p.n >= 0 && p.n < k && p.c >= 0 && p.c < k,
               "IMLS pair (" << p.n << ", " << p.c << ") out of range");
   if (!odometry.empty()) odometry.Check("global input odometry");
+  for (const auto& l : loops)
+    JVL_CHECK(l.match >= 0 && l.match < l.query && l.query < k,
+              "loop (" << l.match << ", " << l.query << ") out of range or not match < query");
+}
+
+double ApplyLoopCorrections(GlobalMapInput* input) {
+  std::vector<LoopConstraint> loops = input->loops;
+  std::stable_sort(
+      loops.begin(), loops.end(),
+      [](const LoopConstraint& a, const LoopConstraint& b) { return a.query < b.query; });
+  std::vector<Rigid3d>& poses = input->keyframes.world_from_cam;
+  const std::vector<Rigid3d> before = poses;
+  for (const LoopConstraint& l : loops) {
+    const size_t m = static_cast<size_t>(l.match), q = static_cast<size_t>(l.query);
+    const Rigid3d target = poses[m] * l.match_from_query;
+    const std::vector<Rigid3d> segment(poses.begin() + static_cast<std::ptrdiff_t>(m),
+                                       poses.begin() + static_cast<std::ptrdiff_t>(q) + 1);
+    std::vector<double> positions;
+    for (size_t i = m; i <= q; ++i)
+      positions.push_back(static_cast<double>(input->keyframes.frames[i]));
+    const std::vector<Rigid3d> corrected = optim::DistributeCorrection(segment, target, positions);
+    const Rigid3d after = corrected.back() * poses[q].Inverse();  // world frame
+    for (size_t i = m; i <= q; ++i) poses[i] = corrected[i - m];
+    for (size_t i = q + 1; i < poses.size(); ++i) poses[i] = after * poses[i];
+  }
+  // Map points follow their first observer.
+  std::vector<int64_t> first(input->map_points.size(), -1);
+  for (const auto& o : input->observations) {
+    int64_t& f = first[static_cast<size_t>(o.map_point)];
+    if (f < 0 || o.keyframe < f) f = o.keyframe;
+  }
+  for (size_t p = 0; p < first.size(); ++p) {
+    if (first[p] < 0) continue;
+    const size_t k = static_cast<size_t>(first[p]);
+    input->map_points[p] = poses[k] * (before[k].Inverse() * input->map_points[p]);
+  }
+  double largest = 0;
+  for (size_t i = 0; i < poses.size(); ++i)
+    largest = std::max(largest, (poses[i].translation() - before[i].translation()).norm());
+  return largest;
 }
 
 void ImlsTraversalOptions::Check() const {
@@ -270,6 +311,27 @@ std::vector<optim::ImlsCorrespondence> TraverseImls(const Trajectory& keyframes,
 }
 
 namespace {
+
+// Loop constraints: each loop's query scan against the scans of the keyframes within
+// scan_map_size frames of its match (earlier than the query), at the current poses.
+std::vector<optim::ImlsCorrespondence> TraverseLoops(const Trajectory& keyframes,
+                                                     const std::vector<lidar::StoredScan>& scans,
+                                                     const std::vector<LoopConstraint>& loops,
+                                                     const ImlsTraversalOptions& options) {
+  std::vector<optim::ImlsCorrespondence> out;
+  for (const LoopConstraint& l : loops) {
+    const size_t m = static_cast<size_t>(l.match), q = static_cast<size_t>(l.query);
+    lidar::ImlsModel model(options.association.search_radius);
+    for (size_t i = 0; i < q; ++i) {
+      if (std::abs(keyframes.frames[i] - keyframes.frames[m]) > options.scan_map_size) continue;
+      lidar::AddScanToModel(scans[i].points, scans[i].normals, keyframes.world_from_cam[i],
+                            static_cast<int64_t>(i), &model);
+    }
+    const auto c = TraverseKeyframe(keyframes, scans, q, model, options);
+    out.insert(out.end(), c.begin(), c.end());
+  }
+  return out;
+}
 
 // What stays the same over the rounds of Eq. (7).
 struct FixedTerms {
@@ -654,6 +716,17 @@ void SetImlsTerm(int round, const FixedTerms& terms, const GlobalMappingOptions&
     problem->imls.insert(problem->imls.end(), l.begin(), l.end());
   }
   result->fresh_imls = static_cast<int64_t>(l.size());
+  if (options.use_loops && !input->loops.empty()) {
+    const auto loop_l =
+        TraverseLoops(result->keyframes, input->scans, input->loops, options.traversal);
+    if (terms.aggregate) {
+      const auto loop_pairs = optim::AggregateImls(loop_l);
+      problem->imls_pairs.insert(problem->imls_pairs.end(), loop_pairs.begin(), loop_pairs.end());
+    } else {
+      problem->imls.insert(problem->imls.end(), loop_l.begin(), loop_l.end());
+    }
+    result->loop_imls = static_cast<int64_t>(loop_l.size());
+  }
   result->traversal_time_s += t.ElapsedSeconds();
   spdlog::debug("round {}: fresh IMLS traversal {:.1f} s ({} correspondences)", round + 1,
                 t.ElapsedSeconds(), l.size());
@@ -722,6 +795,12 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   options.Check();
   input.Check();
   GlobalMappingResult result;
+  if (options.use_loops && !input.loops.empty()) {
+    result.loop_correction_m = ApplyLoopCorrections(&input);
+    result.loops_used = static_cast<int64_t>(input.loops.size());
+    spdlog::info("loops: {} applied before the optimisation (keyframes moved by up to {:.3f} m)",
+                 input.loops.size(), result.loop_correction_m);
+  }
   result.keyframes = input.keyframes;
   SelectVisualTerm(options, &input, &result);
   const FixedTerms terms = PrepareFixedTerms(&input, options, &result);
@@ -807,7 +886,21 @@ nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
 
 }  // namespace
 
+namespace {
+nlohmann::json GlobalStatsCore(const GlobalMappingResult& r, const GlobalMappingOptions& o);
+}  // namespace
+
 nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMappingOptions& o) {
+  nlohmann::json j = GlobalStatsCore(r, o);
+  if (r.loops_used > 0) {
+    j["loops"] = {
+        {"used", r.loops_used}, {"imls", r.loop_imls}, {"correction_m", r.loop_correction_m}};
+  }
+  return j;
+}
+
+namespace {
+nlohmann::json GlobalStatsCore(const GlobalMappingResult& r, const GlobalMappingOptions& o) {
   const auto& s = r.solve;
   return {
       {"before", BreakdownOf(s.before)},
@@ -880,6 +973,7 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
       {"traversal_time_s", r.traversal_time_s},
       {"total_time_s", r.total_time_s}};
 }
+}  // namespace
 
 std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,
                                            const std::vector<lidar::StoredScan>& scans,

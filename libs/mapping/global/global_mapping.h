@@ -28,6 +28,14 @@
 
 namespace jvl::mapping {
 
+// A verified loop (loop_detect): keyframe rows of its two ends and the relative pose measured
+// between them (cam0 frames).
+struct LoopConstraint {
+  int64_t query = 0;  // The later keyframe ...
+  int64_t match = 0;  // ... and the earlier one it revisits (match < query).
+  Rigid3d match_from_query;
+};
+
 // Everything the global problem needs; keyframe references are rows of `keyframes`.
 struct GlobalMapInput {
   PinholeCamera camera;
@@ -47,8 +55,19 @@ struct GlobalMapInput {
   // The odometry of the odometry term e_O (GlobalMappingOptions::use_odometry): any trajectory
   // holding the keyframes' frames (e.g. the lidar_odom prior). Empty: no e_O.
   Trajectory odometry;
+  // Loops (GlobalMappingOptions::use_loops): the keyframes are corrected before the first round
+  // (ApplyLoopCorrections), and every round adds point-to-IMLS correspondences of each loop's
+  // query scan against the scans around its match.
+  std::vector<LoopConstraint> loops;
   void Check() const;
 };
+
+// Algorithm 1 of the supplement for every loop, in the order of their query keyframes: the
+// query's pose becomes match x match_from_query, the keyframes between match and query get
+// the correction spread linearly over the frames (optim::DistributeCorrection, log/exp on the
+// rotation), and the keyframes after the query move with it. A map point follows the correction
+// of its first observing keyframe. Returns the largest change of a keyframe position (m).
+double ApplyLoopCorrections(GlobalMapInput* input);
 
 // Fresh point-to-IMLS traversal (local mapping steps 2-4 for every keyframe).
 struct ImlsTraversalOptions {
@@ -146,6 +165,10 @@ struct GlobalMappingOptions {
   // least this many observations, or all of its own (SelectObservations): the cost of a
   // free-map-point solve grows with the observations. 0 = every point.
   int points_per_keyframe = 200;
+  // Loops of GlobalMapInput::loops: corrected before the first round and tied by IMLS
+  // correspondences of the query scan against the scans of the keyframes within
+  // traversal.scan_map_size frames of the match (false: the --no-loops ablation).
+  bool use_loops = true;
   void Check() const;
 
   // Preset for inputs whose map points are not consistent with the poses (e.g. placed from the
@@ -158,6 +181,8 @@ struct GlobalMappingResult {
   optim::JointSolveResult solve;
   Trajectory keyframes;  // Optimised (same frames as the input keyframes).
   int64_t saved_imls = 0, fresh_imls = 0;
+  int64_t loops_used = 0, loop_imls = 0;  // Loops entered; their correspondences (last round).
+  double loop_correction_m = 0;           // Largest keyframe move by the loop correction.
   int64_t directions_used = 0, directions_not_keyframe = 0, directions_at_infinity = 0;
   // DirectionSource::kRefit: VPs dropped as outliers / in too small clusters, and the change of
   // each cluster's d_w (degrees) against the directions artifact.

@@ -379,6 +379,82 @@ TEST(GlobalMapping, SelectObservationsKeepsEnoughInEveryKeyframeDeterministicall
   }
 }
 
+// Algorithm 1 offline: the query lands on match x match_from_query, the match keeps its pose,
+// the keyframes between are moved by part of the correction, the ones after by all of it, and a
+// map point keeps its place in its first observer's frame.
+TEST(GlobalMapping, LoopCorrectionMovesTheQueryOntoItsMeasuredPose) {
+  GlobalMapInput in;
+  std::vector<Rigid3d> truth;
+  for (int k = 0; k < 22; ++k) {
+    truth.emplace_back(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 2.0 * k));
+    // The prior drifts sideways and turns slowly.
+    in.keyframes.Append(3 * k, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.002 * k, 0)),
+                                       Eigen::Vector3d(0.01 * k * k, 0, 2.0 * k)));
+  }
+  in.map_points = {Eigen::Vector3d(1, -1, 30)};
+  in.observations.push_back({});
+  in.observations.back().keyframe = 12;
+  in.observations.back().map_point = 0;
+  in.observations.push_back(in.observations.back());
+  in.observations.back().keyframe = 10;  // the first observer
+  const Rigid3d rel = truth[2].Inverse() * truth[20];
+  in.loops.push_back({20, 2, rel});
+  const GlobalMapInput before = in;
+  const double moved = ApplyLoopCorrections(&in);
+  const auto& p = in.keyframes.world_from_cam;
+  const auto& b = before.keyframes.world_from_cam;
+  const Rigid3d landed = p[2].Inverse() * p[20];
+  EXPECT_LT((landed.translation() - rel.translation()).norm(), 1e-9);
+  EXPECT_LT(RotationAngle(landed.rotation() * rel.rotation().inverse()), 1e-9);
+  for (int k = 0; k <= 2; ++k) EXPECT_EQ(p[k].ToArray(), b[k].ToArray());
+  // Between: a growing share of the correction.
+  double last = 0;
+  for (int k = 3; k < 20; ++k) {
+    const double d = (p[k].translation() - b[k].translation()).norm();
+    EXPECT_GT(d, last) << k;
+    last = d;
+  }
+  // After: rigidly with the query.
+  const Rigid3d after_before = b[20].Inverse() * b[21], after_now = p[20].Inverse() * p[21];
+  EXPECT_LT((after_before.translation() - after_now.translation()).norm(), 1e-9);
+  EXPECT_NEAR(moved, (p[21].translation() - b[21].translation()).norm(), 1e-9);
+  EXPECT_LT(
+      ((b[10].Inverse() * before.map_points[0]) - (p[10].Inverse() * in.map_points[0])).norm(),
+      1e-9);
+}
+
+// The loop term: the query's scan meets the scans around its match, and the loop is reported.
+TEST(GlobalMapping, LoopsAddCorrespondencesBetweenTheirTwoEnds) {
+  SyntheticGlobalOptions so;
+  so.keyframes = 24;
+  so.biased_local = false;
+  auto synthetic = MakeSyntheticGlobal(so);
+  // A revisit-like pair within scan range: keyframe 23 and keyframe 16, 14 m apart.
+  synthetic.input.loops.push_back(
+      {23, 16, synthetic.truth_keyframes[16].Inverse() * synthetic.truth_keyframes[23]});
+  GlobalMappingOptions o = Quiet();
+  o.use_directions = false;
+  const GlobalMappingResult with = OptimizeGlobal(synthetic.input, o);
+  EXPECT_EQ(with.loops_used, 1);
+  EXPECT_GT(with.loop_imls, 100);
+  EXPECT_GT(with.loop_correction_m, 0.0);
+  o.use_loops = false;
+  const GlobalMappingResult without = OptimizeGlobal(synthetic.input, o);
+  EXPECT_EQ(without.loops_used, 0);
+  EXPECT_EQ(without.loop_imls, 0);
+  // The loop's relative pose is the truth's: with it, the two ends agree with the truth better.
+  const auto rel_error = [&](const GlobalMappingResult& r) {
+    const Rigid3d e =
+        (synthetic.truth_keyframes[16].Inverse() * synthetic.truth_keyframes[23]).Inverse() *
+        (r.keyframes.world_from_cam[16].Inverse() * r.keyframes.world_from_cam[23]);
+    return e.translation().norm();
+  };
+  EXPECT_LT(rel_error(with), rel_error(without));
+  const nlohmann::json stats = GlobalStatsJson(with, o);
+  EXPECT_EQ(stats.at("loops").at("used").get<int64_t>(), 1);
+  EXPECT_FALSE(GlobalStatsJson(without, o).contains("loops"));
+}
+
 TEST(GlobalMapping, AccumulatedMapIsVoxelDownsampled) {
   SyntheticGlobalOptions so;
   so.keyframes = 4;
