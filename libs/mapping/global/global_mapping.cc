@@ -886,23 +886,9 @@ nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
 
 }  // namespace
 
-namespace {
-nlohmann::json GlobalStatsCore(const GlobalMappingResult& r, const GlobalMappingOptions& o);
-}  // namespace
-
 nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMappingOptions& o) {
-  nlohmann::json j = GlobalStatsCore(r, o);
-  if (r.loops_used > 0) {
-    j["loops"] = {
-        {"used", r.loops_used}, {"imls", r.loop_imls}, {"correction_m", r.loop_correction_m}};
-  }
-  return j;
-}
-
-namespace {
-nlohmann::json GlobalStatsCore(const GlobalMappingResult& r, const GlobalMappingOptions& o) {
   const auto& s = r.solve;
-  return {
+  nlohmann::json j = {
       {"before", BreakdownOf(s.before)},
       {"after", BreakdownOf(s.after)},
       {"weights",
@@ -972,8 +958,12 @@ nlohmann::json GlobalStatsCore(const GlobalMappingResult& r, const GlobalMapping
         {"max_iterations", o.solve.max_iterations}}},
       {"traversal_time_s", r.traversal_time_s},
       {"total_time_s", r.total_time_s}};
+  if (r.loops_used > 0) {
+    j["loops"] = {
+        {"used", r.loops_used}, {"imls", r.loop_imls}, {"correction_m", r.loop_correction_m}};
+  }
+  return j;
 }
-}  // namespace
 
 std::vector<Eigen::Vector3f> AccumulateMap(const Trajectory& keyframes,
                                            const std::vector<lidar::StoredScan>& scans,

@@ -95,10 +95,8 @@ std::vector<int> VisualMapBuilder::Track(const vision::OrbFeatures& features,
     const vision::PoseRefinement r =
         vision::RefinePose(map_.camera, obs, predicted_pose, options_.pose, center);
     const Rigid3d change = r.cam_from_world * predicted_pose.Inverse();
-    const bool small =
-        RotationAngle(change.rotation()) * 180.0 / M_PI <= options_.track_max_rotation_deg &&
-        (r.cam_from_world.Inverse().translation() - center).norm() <=
-            options_.track_max_translation_m;
+    report->correction_deg = RotationAngle(change.rotation()) * 180.0 / M_PI;
+    report->correction_m = (r.cam_from_world.Inverse().translation() - center).norm();
     report->pose_inliers = r.inliers;
     for (const vision::PointObservation& o : obs) {
       const double s2 = o.level_scale * o.level_scale;
@@ -107,8 +105,8 @@ std::vector<int> VisualMapBuilder::Track(const vision::OrbFeatures& features,
         ++report->predicted_inliers;
       }
     }
-    report->correction_deg = RotationAngle(change.rotation()) * 180.0 / M_PI;
-    report->correction_m = (r.cam_from_world.Inverse().translation() - center).norm();
+    const bool small = report->correction_deg <= options_.track_max_rotation_deg &&
+                       report->correction_m <= options_.track_max_translation_m;
     const bool disagree = report->correction_deg > options_.track_min_rotation_deg ||
                           report->correction_m > options_.track_min_translation_m;
     const bool explains_more =
