@@ -17,7 +17,12 @@ struct RayCaster::Impl {
 RayCaster::RayCaster(const Mesh& mesh) : impl_(std::make_unique<Impl>()) {
   JVL_CHECK(!mesh.triangles.empty(), "scene mesh is empty");
   impl_->mesh = &mesh;
-  impl_->device = rtcNewDevice("threads=1");
+  // Embree picks its kernels by the CPU (SSE2 ... AVX-512) and they do not round alike: the
+  // same scene gave hit distances one or two float ULPs apart with AVX2 (FMA) or AVX-512 kernels,
+  // which moved scan points by ~1e-6 m and image pixels by a grey level. The SSE2 kernels run on
+  // every x86-64 CPU (the SSE4.2 and AVX kernels give the same bytes), so the simulator writes the
+  // same data on every machine; they cost about 25 % of sim_sequence's time.
+  impl_->device = rtcNewDevice("threads=1,isa=sse2");
   JVL_CHECK(impl_->device != nullptr,
             "cannot create the Embree device (error " << rtcGetDeviceError(nullptr) << ")");
   impl_->scene = rtcNewScene(impl_->device);
