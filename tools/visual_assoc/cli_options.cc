@@ -61,7 +61,7 @@ void AddVisualMapFlags(app::Tool& tool, mapping::VisualMapOptions* o) {
              "Refine points and drop outlier observations as keyframes are added");
   method.Add("--track-pose", o->track_pose,
              "Refine each frame's pose from its matches where the prior's motion disagrees with "
-             "them (a registration glitch); false: the prior's pose");
+             "them (a registration glitch); false: every frame at the prior's pose (the paper)");
   method.Add("--track-min-inliers", o->track_min_inliers,
              "Inliers a refined pose needs to be used");
   method.Add(

@@ -67,7 +67,7 @@ struct VisualMapOptions {
   // the points are then matched again at the refined pose. Elsewhere the prior's motion is kept:
   // it is locally far more precise than a monocular estimate. false: every frame takes the
   // prior's pose (the paper).
-  bool track_pose = false;
+  bool track_pose = true;
   int track_min_inliers = 40;
   double track_min_inlier_gain = 1.2;
   double track_min_rotation_deg = 0.15;
