@@ -15,17 +15,34 @@
 #include "core/hash.h"
 #include "io/files.h"
 #include "io/kitti.h"
+#include "io/kitti360.h"
+#include "io/kitti_raw.h"
 #include "io/trajectory_io.h"
 
 namespace fs = std::filesystem;
 
 namespace jvl::io {
 
+const char* DatasetFormatName(DatasetFormat format) {
+  switch (format) {
+    case DatasetFormat::kKittiOdometry:
+      return "kitti";
+    case DatasetFormat::kKittiRaw:
+      return "kitti-raw";
+    case DatasetFormat::kKitti360:
+      return "kitti360";
+    case DatasetFormat::kAuto:
+      break;
+  }
+  return "auto";
+}
+
 DatasetFormat ParseDatasetFormat(const std::string& name) {
   if (name == "auto") return DatasetFormat::kAuto;
   if (name == "kitti") return DatasetFormat::kKittiOdometry;
   if (name == "kitti-raw") return DatasetFormat::kKittiRaw;
-  JVL_THROW("--format: unknown dataset format '" << name << "' (auto, kitti, kitti-raw)");
+  if (name == "kitti360") return DatasetFormat::kKitti360;
+  JVL_THROW("--format: unknown dataset format '" << name << "' (auto, kitti, kitti-raw, kitti360)");
 }
 
 bool ResolveDeskew(const std::string& mode, const Dataset& dataset) {
@@ -41,6 +58,8 @@ bool ResolveDeskew(const std::string& mode, const Dataset& dataset) {
 DatasetFormat DetectDatasetFormat(const std::string& dir) {
   JVL_CHECK(IsDirectory(dir), dir << ": dataset folder not found");
   const fs::path p(dir);
+  // Before KITTI raw: a KITTI-360 data_3d_raw drive folder also holds velodyne_points/data.
+  if (LocateKitti360(dir)) return DatasetFormat::kKitti360;
   if (FileExists((p / "calib.txt").string()) &&
       (IsDirectory((p / "velodyne").string()) || IsDirectory((p / "image_0").string()))) {
     return DatasetFormat::kKittiOdometry;
@@ -50,7 +69,8 @@ DatasetFormat DetectDatasetFormat(const std::string& dir) {
     return DatasetFormat::kKittiRaw;
   }
   JVL_THROW(dir << ": unknown dataset layout (expected a KITTI odometry sequence folder with "
-                   "calib.txt and velodyne/ or image_0/, or a KITTI raw *_sync folder)");
+                   "calib.txt and velodyne/ or image_0/, a KITTI raw *_sync folder, or a KITTI-360 "
+                   "drive folder ROOT/data_3d_raw/DRIVE with ROOT/calibration/perspective.txt)");
 }
 
 std::map<int64_t, std::string> ListNumberedFiles(const std::string& dir, const std::string& ext) {
@@ -146,8 +166,6 @@ cv::Mat LoadImageChecked(const std::string& path, int64_t frame, int camera,
   return image;
 }
 
-namespace {
-
 // sim_sequence writes its options to sim/scene.json; its scans are raw when it moved the LiDAR
 // during the sweep. A folder without the file (real KITTI odometry) is compensated.
 bool SimulatedWithMotionDistortion(const std::string& scene_path) {
@@ -165,6 +183,8 @@ bool SimulatedWithMotionDistortion(const std::string& scene_path) {
   }
   return (*lidar)["motion_distortion"].get<bool>();
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 class KittiOdometryDataset : public Dataset {
@@ -255,15 +275,12 @@ std::vector<std::string> Dataset::InputFiles() const {
   return files;
 }
 
-}  // namespace jvl::io
-#include "io/kitti_raw.h"
-namespace jvl::io {
-
 std::unique_ptr<Dataset> OpenDataset(const std::string& dir, DatasetFormat format,
                                      const FrameRange& range) {
   JVL_CHECK(IsDirectory(dir), dir << ": dataset folder not found");
   if (format == DatasetFormat::kAuto) format = DetectDatasetFormat(dir);
   if (format == DatasetFormat::kKittiRaw) return OpenKittiRawDataset(dir, range);
+  if (format == DatasetFormat::kKitti360) return OpenKitti360Dataset(dir, range);
   return std::make_unique<KittiOdometryDataset>(dir, range);
 }
 

@@ -1,5 +1,6 @@
-// Datasets named by folder: KITTI odometry sequence folders (also written by sim_sequence) and
-// KITTI raw drive folders. Frames are loaded lazily, one at a time.
+// Datasets named by folder: KITTI odometry sequence folders (also written by sim_sequence),
+// KITTI raw drive folders and KITTI-360 drives (io/kitti360.h). Frames are loaded lazily, one at a
+// time.
 #pragma once
 
 #include <map>
@@ -16,8 +17,12 @@
 
 namespace jvl::io {
 
-enum class DatasetFormat { kAuto, kKittiOdometry, kKittiRaw };
-DatasetFormat ParseDatasetFormat(const std::string& name);  // auto|kitti|kitti-raw
+enum class DatasetFormat { kAuto, kKittiOdometry, kKittiRaw, kKitti360 };
+DatasetFormat ParseDatasetFormat(const std::string& name);  // auto|kitti|kitti-raw|kitti360
+const char* DatasetFormatName(DatasetFormat format);        // the name ParseDatasetFormat takes
+// Help text of the tools' --format option.
+inline constexpr const char* kDatasetFormatHelp =
+    "Dataset layout: auto (detected from the folder), kitti, kitti-raw or kitti360";
 
 class Dataset {
  public:
@@ -25,7 +30,8 @@ class Dataset {
 
   DatasetFormat format() const { return format_; }
   const std::string& root() const { return root_; }
-  // Stable identity of the sequence ("kitti:04", "kitti-raw:2011_09_26_drive_0001_sync").
+  // Stable identity of the sequence ("kitti:04", "kitti-raw:2011_09_26_drive_0001_sync:<hash>",
+  // "kitti360:2013_05_28_drive_0000_sync:<hash>").
   const std::string& id() const { return id_; }
   // Selected frame ids (dataset numbering), increasing.
   const std::vector<int64_t>& frames() const { return frames_; }
@@ -74,7 +80,7 @@ std::unique_ptr<Dataset> OpenDataset(const std::string& dir,
                                      const FrameRange& range = {});
 DatasetFormat DetectDatasetFormat(const std::string& dir);
 
-// The rules every dataset reader applies (KITTI odometry, KITTI raw):
+// The rules every dataset reader applies (KITTI odometry, KITTI raw, KITTI-360):
 // - the frames of a sequence are every number from the first to the last file found among its
 //   scans and images; a frame whose file is missing is an error when a tool reads it;
 // - --frames must select at least one frame and may not end past the last one;
@@ -90,6 +96,9 @@ void SelectFrames(const std::vector<int64_t>& all, const FrameRange& range, cons
 // - every image has the size of the sequence (calibration.image_width/height, taken from
 //   `size_source`), and at least kMinImageSide pixels a side.
 PointCloud LoadScanChecked(const std::string& path, int64_t frame, size_t* dropped);
+// Whether sim_sequence's scene.json at `scene_path` says the LiDAR moved during its sweeps
+// (lidar.motion_distortion); false, with a warning, if the file lacks the field.
+bool SimulatedWithMotionDistortion(const std::string& scene_path);
 inline constexpr int kMinImageSide = 64;  // ORB's 31-pixel patches on a pyramid need room
 cv::Mat LoadImageChecked(const std::string& path, int64_t frame, int camera,
                          const Calibration& calibration, const std::string& size_source);

@@ -12,6 +12,7 @@
 #include "core/hash.h"
 #include "io/files.h"
 #include "io/kitti.h"
+#include "io/kitti_text.h"
 
 namespace fs = std::filesystem;
 
@@ -65,61 +66,7 @@ int64_t DaysFromCivil(int64_t y, unsigned m, unsigned d) {
   return era * 146097 + static_cast<int64_t>(doe) - 719468;
 }
 
-// key: values lines of the raw calibration files.
-std::map<std::string, std::vector<double>> ReadKeyValues(const std::string& path) {
-  std::ifstream in(path);
-  JVL_CHECK(in.good(), path << ": calibration file not found (KITTI raw keeps calib_*.txt one "
-                               "folder above the drive)");
-  std::map<std::string, std::vector<double>> out;
-  std::string line;
-  while (std::getline(in, line)) {
-    const auto colon = line.find(':');
-    if (colon == std::string::npos) continue;
-    const std::string key(Trim(std::string_view(line).substr(0, colon)));
-    std::vector<double> values;
-    bool numeric = true;
-    for (auto tok : SplitWhitespace(std::string_view(line).substr(colon + 1))) {
-      const auto v = ParseDouble(tok);
-      if (!v) {
-        numeric = false;
-        break;
-      }
-      values.push_back(*v);
-    }
-    if (numeric) out[key] = values;
-  }
-  return out;
-}
-
-const std::vector<double>& Require(const std::map<std::string, std::vector<double>>& kv,
-                                   const std::string& key, size_t n, const std::string& path) {
-  const auto it = kv.find(key);
-  JVL_CHECK(it != kv.end() && it->second.size() == n,
-            path << ": missing or malformed '" << key << "' (" << n << " numbers expected)");
-  return it->second;
-}
-
-Rigid3d RigidFromRT(const std::vector<double>& r, const std::vector<double>& t,
-                    const std::string& path) {
-  Eigen::Matrix<double, 3, 4> m;
-  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = r[i];
-  m.col(3) = Eigen::Vector3d(t[0], t[1], t[2]);
-  const double deviation = Rigid3d::RotationDeviation(m.leftCols<3>());
-  JVL_CHECK(deviation < 1e-2 && m.col(3).allFinite(),
-            path << ": not a rigid transform (rotation part off by " << deviation << ")");
-  return Rigid3d::FromMatrix(m);
-}
-
-std::vector<std::string> ReadLines(const std::string& path) {
-  std::ifstream in(path);
-  JVL_CHECK(in.good(), path << ": not found");
-  std::vector<std::string> lines;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (!Trim(line).empty()) lines.push_back(line);
-  }
-  return lines;
-}
+constexpr const char* kCalibHint = "KITTI raw keeps calib_*.txt one folder above the drive";
 
 class KittiRawDataset : public Dataset {
  public:
@@ -136,25 +83,25 @@ class KittiRawDataset : public Dataset {
     const std::string v2c = (date_dir / "calib_velo_to_cam.txt").string();
     const std::string i2v = (date_dir / "calib_imu_to_velo.txt").string();
     key_files_ = {c2c, v2c, i2v};
-    const auto cam = ReadKeyValues(c2c);
+    const auto cam = ReadKeyValues(c2c, kCalibHint);
     for (int i = 0; i < 4; ++i) {
-      const auto& v = Require(cam, "P_rect_0" + std::to_string(i), 12, c2c);
+      const auto& v = RequireValues(cam, "P_rect_0" + std::to_string(i), 12, c2c);
       for (int k = 0; k < 12; ++k) {
         JVL_CHECK(std::isfinite(v[k]), c2c << ": P_rect_0" << i << " has a non-finite value");
         calibration_.P[i](k / 4, k % 4) = v[k];
       }
     }
-    const auto& rr = Require(cam, "R_rect_00", 9, c2c);
+    const auto& rr = RequireValues(cam, "R_rect_00", 9, c2c);
     const Rigid3d rect_from_cam0 = RigidFromRT(rr, {0, 0, 0}, c2c);
-    const auto& size = Require(cam, "S_rect_00", 2, c2c);
+    const auto& size = RequireValues(cam, "S_rect_00", 2, c2c);
     JVL_CHECK(size[0] >= 1 && size[0] <= 1e5 && size[1] >= 1 && size[1] <= 1e5,
               c2c << ": S_rect_00 is not an image size");
     calibration_.image_width = static_cast<int>(size[0]);
     calibration_.image_height = static_cast<int>(size[1]);
     image_size_source_ = c2c + ", S_rect_00";
-    const auto velo = ReadKeyValues(v2c);
+    const auto velo = ReadKeyValues(v2c, kCalibHint);
     const Rigid3d cam0_from_velo_unrect =
-        RigidFromRT(Require(velo, "R", 9, v2c), Require(velo, "T", 3, v2c), v2c);
+        RigidFromRT(RequireValues(velo, "R", 9, v2c), RequireValues(velo, "T", 3, v2c), v2c);
     calibration_.cam0_from_velo = rect_from_cam0 * cam0_from_velo_unrect;
 
     scans_ = ListNumberedFiles((drive / "velodyne_points" / "data").string(), ".bin");
@@ -166,13 +113,7 @@ class KittiRawDataset : public Dataset {
     const std::string stamps =
         (drive / (scans_.empty() ? "image_00" : "velodyne_points") / "timestamps.txt").string();
     if (FileExists(stamps)) {
-      const auto lines = ReadLines(stamps);
-      JVL_CHECK(
-          static_cast<int64_t>(lines.size()) > all.back(),
-          stamps << ": " << lines.size() << " timestamps but the drive has frame " << all.back());
-      const double t0 = ParseKittiRawTimestamp(lines.front(), stamps);
-      for (int64_t f : frames_)
-        timestamps_.push_back(ParseKittiRawTimestamp(lines[f], stamps) - t0);
+      timestamps_ = RelativeKittiRawTimes(stamps, all.back(), frames_);
     } else {
       spdlog::warn("{}: no timestamps.txt, assuming 10 Hz", dir);
       for (int64_t f : frames_) timestamps_.push_back(0.1 * f);
@@ -192,9 +133,9 @@ class KittiRawDataset : public Dataset {
         ground_truth_files_.push_back(path);
       }
       const auto imu0_from_imu = OxtsToImuPoses(packets);
-      const auto imu = ReadKeyValues(i2v);
+      const auto imu = ReadKeyValues(i2v, kCalibHint);
       const Rigid3d velo_from_imu =
-          RigidFromRT(Require(imu, "R", 9, i2v), Require(imu, "T", 3, i2v), i2v);
+          RigidFromRT(RequireValues(imu, "R", 9, i2v), RequireValues(imu, "T", 3, i2v), i2v);
       const Rigid3d cam0_from_imu = calibration_.cam0_from_velo * velo_from_imu;
       const Rigid3d imu_from_cam0 = cam0_from_imu.Inverse();
       Trajectory gt;
@@ -241,7 +182,7 @@ class KittiRawDataset : public Dataset {
 
 }  // namespace
 
-double ParseKittiRawTimestamp(const std::string& text, const std::string& name) {
+KittiRawTime ParseKittiRawTime(const std::string& text, const std::string& name) {
   const std::string s(Trim(text));
   int y = 0, mo = 0, d = 0, h = 0, mi = 0;
   char frac[32] = {0};
@@ -251,9 +192,29 @@ double ParseKittiRawTimestamp(const std::string& text, const std::string& name) 
   JVL_CHECK(n >= 6 && mo >= 1 && mo <= 12 && d >= 1 && d <= 31,
             name << ": bad timestamp '" << s << "' (expected YYYY-MM-DD HH:MM:SS.fffffffff)");
   const int64_t days = DaysFromCivil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d));
-  double seconds = static_cast<double>(days * 86400 + h * 3600 + mi * 60 + sec);
-  if (n == 7) seconds += *ParseDouble(std::string("0.") + frac);
-  return seconds;
+  KittiRawTime t;
+  t.seconds = days * 86400 + h * 3600 + mi * 60 + sec;
+  if (n == 7) t.fraction = *ParseDouble(std::string("0.") + frac);
+  return t;
+}
+
+double ParseKittiRawTimestamp(const std::string& text, const std::string& name) {
+  const KittiRawTime t = ParseKittiRawTime(text, name);
+  return static_cast<double>(t.seconds) + t.fraction;
+}
+
+std::vector<double> RelativeKittiRawTimes(const std::string& path, int64_t last_frame,
+                                          const std::vector<int64_t>& frames) {
+  const auto lines = ReadLines(path);
+  JVL_CHECK(static_cast<int64_t>(lines.size()) > last_frame,
+            path << ": " << lines.size() << " timestamps but the drive has frame " << last_frame);
+  const KittiRawTime t0 = ParseKittiRawTime(lines.front(), path);
+  std::vector<double> times;
+  for (int64_t f : frames) {
+    const KittiRawTime t = ParseKittiRawTime(lines[static_cast<size_t>(f)], path);
+    times.push_back(static_cast<double>(t.seconds - t0.seconds) + (t.fraction - t0.fraction));
+  }
+  return times;
 }
 
 std::unique_ptr<Dataset> OpenKittiRawDataset(const std::string& dir, const FrameRange& range) {

@@ -21,6 +21,12 @@ std::string Numbered(int64_t frame, const char* ext) {
   return buf;
 }
 
+std::string Numbered10(int64_t frame, const char* ext) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%010lld%s", static_cast<long long>(frame), ext);
+  return buf;
+}
+
 std::string FormatDouble(double v, const char* fmt) {
   if (!std::isfinite(v)) return "nan";
   char buf[64];
@@ -30,19 +36,111 @@ std::string FormatDouble(double v, const char* fmt) {
 
 }  // namespace
 
-std::string KittiLayout::SequenceDir() const { return root + "/sequences/" + sequence; }
-std::string KittiLayout::ScanPath(int64_t f) const {
+SimLayout ParseSimLayout(const std::string& name) {
+  if (name == "kitti") return SimLayout::kKitti;
+  if (name == "kitti360") return SimLayout::kKitti360;
+  JVL_THROW("--layout: unknown layout '" << name << "' (kitti, kitti360)");
+}
+
+std::string SequenceLayout::Drive() const { return "sim_drive_00" + sequence + "_sync"; }
+std::string SequenceLayout::SequenceDir() const {
+  if (layout == SimLayout::kKitti360) return root + "/data_3d_raw/" + Drive();
+  return root + "/sequences/" + sequence;
+}
+std::string SequenceLayout::ScanPath(int64_t f) const {
+  if (layout == SimLayout::kKitti360)
+    return SequenceDir() + "/velodyne_points/data/" + Numbered10(f, ".bin");
   return SequenceDir() + "/velodyne/" + Numbered(f, ".bin");
 }
-std::string KittiLayout::ImagePath(int64_t f) const {
+std::string SequenceLayout::ImagePath(int64_t f) const {
+  if (layout == SimLayout::kKitti360) {
+    return root + "/data_2d_raw/" + Drive() + "/image_00/data_rect/" + Numbered10(f, ".png");
+  }
   return SequenceDir() + "/image_0/" + Numbered(f, ".png");
 }
-std::string KittiLayout::PosesPath() const { return root + "/poses/" + sequence + ".txt"; }
-std::string KittiLayout::SimDir() const { return SequenceDir() + "/sim"; }
+std::string SequenceLayout::PosesPath() const {
+  if (layout == SimLayout::kKitti360) return root + "/data_poses/" + Drive() + "/cam0_to_world.txt";
+  return root + "/poses/" + sequence + ".txt";
+}
+std::string SequenceLayout::SimDir() const { return SequenceDir() + "/sim"; }
 
-void WriteKittiSequenceMetadata(const KittiLayout& layout, const Calibration& calib,
-                                const Trajectory& gt) {
+namespace {
+
+// " m00 m01 ... m23" of a rigid transform, full precision.
+std::string Format3x4(const Rigid3d& t) {
+  const Eigen::Matrix<double, 3, 4> m = t.Matrix3x4();
+  std::string out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) out += " " + FormatDouble(m(r, c), "%.17g");
+  return out;
+}
+
+// KITTI raw / KITTI-360 timestamp of `seconds` after 2013-01-01 00:00:00 (within one day).
+std::string Kitti360Timestamp(double seconds) {
+  JVL_CHECK(seconds >= 0 && seconds < 86400,
+            "KITTI-360 timestamps: " << seconds << " s is not within a day");
+  const auto ns = static_cast<int64_t>(std::llround(seconds * 1e9));
+  const int64_t s = ns / 1000000000, frac = ns % 1000000000;
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "2013-01-01 %02lld:%02lld:%02lld.%09lld",
+                static_cast<long long>(s / 3600), static_cast<long long>(s / 60 % 60),
+                static_cast<long long>(s % 60), static_cast<long long>(frac));
+  return buf;
+}
+
+void WriteKitti360Metadata(const SequenceLayout& layout, const Calibration& calib,
+                           const Trajectory& gt) {
+  const std::string calib_dir = layout.root + "/calibration";
+  const std::string image_dir = layout.root + "/data_2d_raw/" + layout.Drive() + "/image_00";
+  const std::string poses_dir = layout.root + "/data_poses/" + layout.Drive();
+  for (const std::string& d :
+       {calib_dir, layout.SequenceDir() + "/velodyne_points", image_dir, poses_dir})
+    CreateDirectories(d);
+  auto row = [](const Eigen::Matrix<double, 3, 4>& m) {
+    std::string out;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) out += " " + FormatDouble(m(r, c), "%.12e");
+    return out;
+  };
+  std::ostringstream persp;
+  persp << "P_rect_00:" << row(calib.P[0]) << "\n"
+        << "R_rect_00: 1 0 0 0 1 0 0 0 1\n"
+        << "S_rect_00: " << calib.image_width << " " << calib.image_height << "\n"
+        << "P_rect_01:" << row(calib.P[1]) << "\n"
+        << "R_rect_01: 1 0 0 0 1 0 0 0 1\n"
+        << "S_rect_01: " << calib.image_width << " " << calib.image_height << "\n";
+  WriteTextFileAtomic(calib_dir + "/perspective.txt", persp.str());
+  // The unrectified camera is the rectified one (R_rect_00 = identity); the IMU/GPS "pose"
+  // frame is put at the Velodyne.
+  const Rigid3d velo_from_cam0 = calib.cam0_from_velo.Inverse();
+  WriteTextFileAtomic(calib_dir + "/calib_cam_to_velo.txt",
+                      Format3x4(velo_from_cam0).substr(1) + "\n");
+  WriteTextFileAtomic(calib_dir + "/calib_cam_to_pose.txt",
+                      "image_00:" + Format3x4(velo_from_cam0) + "\n");
+  std::string stamps, cam_poses, imu_poses;
+  for (size_t i = 0; i < gt.size(); ++i) {
+    stamps +=
+        Kitti360Timestamp(gt.timestamps.empty() ? 0.1 * gt.frames[i] : gt.timestamps[i]) + "\n";
+    const Rigid3d& w = gt.world_from_cam[i];
+    cam_poses += std::to_string(gt.frames[i]) + Format3x4(w) + " 0 0 0 1\n";
+    imu_poses += std::to_string(gt.frames[i]) + Format3x4(w * velo_from_cam0.Inverse()) + "\n";
+  }
+  JVL_CHECK(gt.frames.front() == 0, "KITTI-360 layout: the ground truth must start at frame 0");
+  WriteTextFileAtomic(layout.SequenceDir() + "/velodyne_points/timestamps.txt", stamps);
+  WriteTextFileAtomic(image_dir + "/timestamps.txt", stamps);
+  WriteTextFileAtomic(layout.PosesPath(), cam_poses);
+  WriteTextFileAtomic(poses_dir + "/poses.txt", imu_poses);
+}
+
+}  // namespace
+
+void WriteSequenceMetadata(const SequenceLayout& layout, const Calibration& calib,
+                           const Trajectory& gt) {
   gt.Check("ground truth");
+  if (layout.layout == SimLayout::kKitti360) {
+    WriteKitti360Metadata(layout, calib, gt);
+    return;
+  }
   CreateDirectories(layout.SequenceDir());
   WriteKittiCalibration(layout.SequenceDir() + "/calib.txt", calib);
   WriteKittiTimes(layout.SequenceDir() + "/times.txt", gt.timestamps);

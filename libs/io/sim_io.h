@@ -17,19 +17,33 @@
 
 namespace jvl::io {
 
-// Paths of a KITTI odometry layout rooted at `root` for sequence `sequence` ("00").
-struct KittiLayout {
+// The dataset layouts a simulated sequence can be written in (sim_sequence --layout).
+enum class SimLayout {
+  kKitti,     // ROOT/sequences/NN/{calib.txt, times.txt, velodyne/, image_0/}, ROOT/poses/NN.txt
+  kKitti360,  // ROOT/calibration/, ROOT/data_3d_raw/DRIVE, data_2d_raw/DRIVE, data_poses/DRIVE
+};
+SimLayout ParseSimLayout(const std::string& name);  // kitti | kitti360
+
+// Paths of a simulated sequence `sequence` ("00") in `layout` rooted at `root`. KITTI-360 names
+// the drive sim_drive_00NN_sync (the sequence as a four-digit drive number).
+struct SequenceLayout {
   std::string root, sequence;
-  std::string SequenceDir() const;
-  std::string ScanPath(int64_t frame) const;   // velodyne/000000.bin
-  std::string ImagePath(int64_t frame) const;  // image_0/000000.png
-  std::string PosesPath() const;               // root/poses/NN.txt
-  std::string SimDir() const;                  // sequences/NN/sim
+  SimLayout layout = SimLayout::kKitti;
+  std::string Drive() const;                   // KITTI-360 drive folder name
+  std::string SequenceDir() const;             // what the tools' --dataset takes
+  std::string ScanPath(int64_t frame) const;   // velodyne/000000.bin, .../data/0000000000.bin
+  std::string ImagePath(int64_t frame) const;  // image_0/000000.png, .../data_rect/0000000000.png
+  std::string PosesPath() const;  // ROOT/poses/NN.txt, data_poses/DRIVE/cam0_to_world.txt
+  std::string SimDir() const;     // SequenceDir()/sim
 };
 
-// calib.txt, times.txt and poses/NN.txt (12-column KITTI, world_from_cam0).
-void WriteKittiSequenceMetadata(const KittiLayout& layout, const Calibration& calib,
-                                const Trajectory& ground_truth);
+// The calibration, the timestamps and the ground truth (world_from_cam0) of the layout:
+// KITTI: calib.txt, times.txt and poses/NN.txt (12 columns). KITTI-360: perspective.txt
+// (P_rect_00/01, R_rect_00 = identity, S_rect_00 = the image size), calib_cam_to_velo.txt,
+// calib_cam_to_pose.txt (the pose frame is the Velodyne's), timestamps.txt of the Velodyne and of
+// camera 0 (from 2013-01-01 00:00:00), cam0_to_world.txt and poses.txt.
+void WriteSequenceMetadata(const SequenceLayout& layout, const Calibration& calib,
+                           const Trajectory& ground_truth);
 
 // One ground-truth vanishing point (see sim/ground_truth.h).
 struct GtVpRow {

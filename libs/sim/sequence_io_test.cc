@@ -42,9 +42,9 @@ SequenceOptions Small(uint64_t seed) {
 
 TEST(SequenceIoTest, SameSeedGivesByteIdenticalFiles) {
   const fs::path a = TempDir("a"), b = TempDir("b"), c = TempDir("c");
-  WriteSequence(*BuildWorld(Small(5)), a.string(), "00", 1, TestProvenance);
-  WriteSequence(*BuildWorld(Small(5)), b.string(), "00", 2, TestProvenance);
-  WriteSequence(*BuildWorld(Small(6)), c.string(), "00", 2, TestProvenance);
+  WriteSequence(*BuildWorld(Small(5)), io::SequenceLayout{a.string(), "00"}, 1, TestProvenance);
+  WriteSequence(*BuildWorld(Small(5)), io::SequenceLayout{b.string(), "00"}, 2, TestProvenance);
+  WriteSequence(*BuildWorld(Small(6)), io::SequenceLayout{c.string(), "00"}, 2, TestProvenance);
   int compared = 0, differ_c = 0;
   for (const auto& e : fs::recursive_directory_iterator(a)) {
     if (!e.is_regular_file()) continue;
@@ -69,10 +69,42 @@ TEST(SequenceIoTest, SameSeedGivesByteIdenticalFiles) {
   fs::remove_all(c);
 }
 
+TEST(SequenceIoTest, Kitti360LayoutReadsBackLikeTheKittiOne) {
+  const fs::path root = TempDir("read360");
+  const auto world = BuildWorld(Small(2));
+  const io::SequenceLayout layout{root.string(), "07", io::SimLayout::kKitti360};
+  WriteSequence(*world, layout, 2, TestProvenance);
+  EXPECT_EQ(layout.SequenceDir(), (root / "data_3d_raw" / "sim_drive_0007_sync").string());
+  const auto ds = io::OpenDataset(layout.SequenceDir());
+  EXPECT_EQ(ds->format(), io::DatasetFormat::kKitti360);
+  EXPECT_TRUE(ds->scans_motion_compensated());  // sim/scene.json: no motion distortion
+  ASSERT_EQ(ds->frames().size(), 4u);
+  EXPECT_NEAR(ds->timestamps()[3], 0.3, 1e-9);
+  const Calibration& c = ds->calibration();
+  const Calibration& truth = world->options.calibration;
+  EXPECT_LT((c.P[0] - truth.P[0]).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((c.P[1] - truth.P[1]).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((c.cam0_from_velo.Matrix3x4() - truth.cam0_from_velo.Matrix3x4()).cwiseAbs().maxCoeff(),
+            1e-12);
+  ASSERT_TRUE(ds->ground_truth().has_value());
+  ASSERT_EQ(ds->ground_truth()->frames, world->ground_truth.frames);
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_LT((ds->ground_truth()->world_from_cam[k].Matrix3x4() -
+               world->ground_truth.world_from_cam[k].Matrix3x4())
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-12);
+  }
+  EXPECT_GT(ds->LoadScan(2).size(), 60000u);
+  EXPECT_EQ(ds->LoadImage(2, 0).cols, 1226);
+  EXPECT_TRUE(fs::exists(root / "data_poses" / "sim_drive_0007_sync" / "poses.txt"));
+  fs::remove_all(root);
+}
+
 TEST(SequenceIoTest, KittiReaderReadsItBack) {
   const fs::path root = TempDir("read");
   const auto world = BuildWorld(Small(2));
-  WriteSequence(*world, root.string(), "07", 2, TestProvenance);
+  WriteSequence(*world, io::SequenceLayout{root.string(), "07"}, 2, TestProvenance);
   const auto ds = io::OpenDataset((root / "sequences" / "07").string());
   EXPECT_EQ(ds->format(), io::DatasetFormat::kKittiOdometry);
   ASSERT_EQ(ds->frames().size(), 4u);
@@ -130,7 +162,7 @@ void CheckRequired(const nlohmann::json& schema, const nlohmann::json& value,
 
 TEST(SequenceIoTest, OutputsMatchTheirSchemas) {
   const fs::path root = TempDir("schema");
-  WriteSequence(*BuildWorld(Small(3)), root.string(), "00", 2, TestProvenance);
+  WriteSequence(*BuildWorld(Small(3)), io::SequenceLayout{root.string(), "00"}, 2, TestProvenance);
   for (const std::string name : {"sim_vps", "sim_scene"}) {
     const auto schema = nlohmann::json::parse(
         Slurp(std::string(JVL_SOURCE_DIR) + "/schemas/" + name + ".schema.json"));

@@ -9,12 +9,11 @@
 
 namespace jvl::sim {
 
-WriteStats WriteSequence(const World& world, const std::string& root, const std::string& sequence,
-                         int threads, const std::function<io::Provenance()>& provenance,
+WriteStats WriteSequence(const World& world, const io::SequenceLayout& layout, int threads,
+                         const std::function<io::Provenance()>& provenance,
                          const std::function<void()>& tick) {
   const SequenceOptions& opt = world.options;
-  const io::KittiLayout layout{root, sequence};
-  io::WriteKittiSequenceMetadata(layout, opt.calibration, world.ground_truth);
+  io::WriteSequenceMetadata(layout, opt.calibration, world.ground_truth);
   std::vector<std::vector<io::GtVpRow>> vps(world.ground_truth.size());
   std::atomic<int64_t> points{0};
   Timer timer;

@@ -1,4 +1,5 @@
-// Writes a simulated world to disk in the KITTI odometry layout plus the sim/ ground truth,
+// Writes a simulated world to disk in a dataset layout (KITTI odometry or KITTI-360) plus the
+// sim/ ground truth,
 // frame-parallel. Only io/ functions touch files; this glues sim/ and io/ for the tool and tests.
 #pragma once
 
@@ -6,6 +7,7 @@
 #include <string>
 
 #include "io/artifact.h"
+#include "io/sim_io.h"
 #include "sim/sequence.h"
 
 namespace jvl::sim {
@@ -18,8 +20,8 @@ struct WriteStats {
 
 // `provenance` is asked for after the frames are written (wall time); `tick` is called once per
 // finished frame (progress display), from worker threads.
-WriteStats WriteSequence(const World& world, const std::string& root, const std::string& sequence,
-                         int threads, const std::function<io::Provenance()>& provenance,
+WriteStats WriteSequence(const World& world, const io::SequenceLayout& layout, int threads,
+                         const std::function<io::Provenance()>& provenance,
                          const std::function<void()>& tick = {});
 
 }  // namespace jvl::sim

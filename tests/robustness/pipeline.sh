@@ -4,22 +4,33 @@
 # Paths inside OUT are relative, so that the provenance (options and input paths) of two runs in
 # different folders is the same and the artifacts compare as equal.
 #
-#   tests/robustness/pipeline.sh BIN_DIR OUT_DIR THREADS [FRAMES]
+#   tests/robustness/pipeline.sh BIN_DIR OUT_DIR THREADS [FRAMES] [LAYOUT]
+#
+# LAYOUT: kitti (default) or kitti360 (the same drive written in the KITTI-360 layout; the
+# ground truth comes from dataset_info --write-gt).
 set -euo pipefail
 
 bin=$(cd "$1" && pwd)
 out=$2
 threads=$3
 frames=${4:-40}
+layout=${5:-kitti}
 
 rm -rf "$out"
 mkdir -p "$out"
 cd "$out"
 common=(--threads "$threads" --log-level warn)
-seq=data/sequences/00
-
-"$bin/sim_sequence" -o data --sequence 00 --seed 1 --frames "$frames" --quiet "${common[@]}"
-"$bin/make_prior" -g data/poses/00.txt -o prior.h5 --preset lidar-n1 --seed 1 "${common[@]}"
+"$bin/sim_sequence" -o data --sequence 00 --seed 1 --frames "$frames" --layout "$layout" --quiet \
+  "${common[@]}"
+if [[ $layout == kitti360 ]]; then
+  seq=data/data_3d_raw/sim_drive_0000_sync
+  gt=gt.txt
+  "$bin/dataset_info" --dataset "$seq" --write-gt "$gt" --quiet "${common[@]}" > /dev/null
+else
+  seq=data/sequences/00
+  gt=data/poses/00.txt
+fi
+"$bin/make_prior" -g "$gt" -o prior.h5 --preset lidar-n1 --seed 1 "${common[@]}"
 "$bin/lidar_odom" --dataset "$seq" -o odom.h5 --kitti-poses odom.txt --quiet "${common[@]}"
 "$bin/vp_detect" --dataset "$seq" -o vps.h5 --csv vps.csv --quiet "${common[@]}"
 "$bin/direction_cluster" --vps vps.h5 --prior prior.h5 -o directions.h5 --csv directions.csv \
@@ -36,5 +47,5 @@ seq=data/sequences/00
   --kitti-poses global.txt --map map.ply "${common[@]}"
 "$bin/global_opt" --local local.h5 --visual visual.h5 --directions directions.h5 --no-direction \
   -o global_nodir.h5 "${common[@]}"
-"$bin/evaluate" --gt data/poses/00.txt --est prior.h5 --est odom.h5 --est global_nodir.h5 \
+"$bin/evaluate" --gt "$gt" --est prior.h5 --est odom.h5 --est global_nodir.h5 \
   --est global.h5 --align se3 --json metrics.json --markdown metrics.md "${common[@]}" > /dev/null

@@ -1,26 +1,39 @@
 // dataset_info: what a dataset folder holds, as the other tools will see it.
+#include <algorithm>
 #include <cstdio>
 
 #include "app/tool.h"
+#include "core/check.h"
 #include "core/progress.h"
+#include "core/timer.h"
 #include "io/dataset.h"
+#include "io/trajectory_io.h"
 
 int main(int argc, char** argv) {
-  jvl::app::Tool tool("dataset_info",
-                      "Print the frames, calibration and ground truth of a dataset folder "
-                      "(KITTI odometry sequence, KITTI raw drive or synthetic sequence).");
-  std::string dataset, format = "auto", frames;
-  bool check_scans = false;
+  jvl::app::Tool tool(
+      "dataset_info",
+      "Print the frames, calibration and ground truth of a dataset folder "
+      "(KITTI odometry sequence, KITTI raw drive, KITTI-360 drive or synthetic sequence).");
+  std::string dataset, format = "auto", frames, write_gt;
+  bool check_scans = false, check_images = false;
   tool.cli().add_option("-d,--dataset", dataset, "Dataset folder")->required();
-  tool.cli().add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  tool.cli().add_option("--format", format, jvl::io::kDatasetFormatHelp)->capture_default_str();
   tool.cli().add_option("--frames", frames, "Frame range A:B (B exclusive)");
-  tool.cli().add_flag("--check-scans", check_scans, "Read every scan and report point counts");
+  tool.cli().add_flag("--check-scans", check_scans,
+                      "Read every scan and report point counts and reading speed");
+  tool.cli().add_flag("--check-images", check_images,
+                      "Read every camera-0 image and report the reading speed");
+  tool.cli().add_option("--write-gt", write_gt,
+                        "Write the ground truth of the selected frames as the tools see it "
+                        "(world_from_cam0, KITTI text with frame numbers: what evaluate --gt "
+                        "takes, e.g. for KITTI-360, whose poses skip frames)");
   return tool.Run(argc, argv, [&] {
     const auto ds = jvl::io::OpenDataset(dataset, jvl::io::ParseDatasetFormat(format),
                                          jvl::ParseFrameRange(frames));
     const auto& c = ds->calibration();
     const auto cam = c.Camera(0);
-    std::printf("dataset      %s\nid           %s\n", ds->root().c_str(), ds->id().c_str());
+    std::printf("dataset      %s\nformat       %s\nid           %s\n", ds->root().c_str(),
+                jvl::io::DatasetFormatName(ds->format()), ds->id().c_str());
     std::printf("frames       %zu (%lld..%lld), %.2f s\n", ds->frames().size(),
                 static_cast<long long>(ds->frames().front()),
                 static_cast<long long>(ds->frames().back()),
@@ -36,20 +49,40 @@ int main(int argc, char** argv) {
         length +=
             (gt.world_from_cam[i].translation() - gt.world_from_cam[i - 1].translation()).norm();
       std::printf("ground truth %zu poses, path length %.2f m\n", gt.size(), length);
+      if (!write_gt.empty()) {
+        jvl::io::WriteTrajectoryKitti(write_gt, gt, /*force_index=*/true);
+        std::printf("wrote        %s\n", write_gt.c_str());
+      }
     } else {
       std::printf("ground truth none\n");
+      JVL_CHECK(write_gt.empty(), "--write-gt: " << dataset << " has no ground truth");
     }
     if (check_scans) {
       size_t total = 0, dropped_total = 0;
       jvl::Progress progress("scans", static_cast<int64_t>(ds->frames().size()), !tool.quiet());
+      jvl::Timer timer;
       for (int64_t f : ds->frames()) {
         size_t dropped = 0;
         total += ds->LoadScan(f, &dropped).size();
         dropped_total += dropped;
         progress.Tick();
       }
-      std::printf("scans        %.0f points per scan on average, %zu non-finite dropped\n",
-                  static_cast<double>(total) / ds->frames().size(), dropped_total);
+      const double seconds = timer.ElapsedSeconds();
+      std::printf(
+          "scans        %.0f points per scan on average, %zu non-finite dropped; read at %.1f "
+          "scans/s\n",
+          static_cast<double>(total) / ds->frames().size(), dropped_total,
+          ds->frames().size() / std::max(seconds, 1e-9));
+    }
+    if (check_images) {
+      jvl::Progress progress("images", static_cast<int64_t>(ds->frames().size()), !tool.quiet());
+      jvl::Timer timer;
+      for (int64_t f : ds->frames()) {
+        ds->LoadImage(f, 0);
+        progress.Tick();
+      }
+      std::printf("images       read at %.1f images/s\n",
+                  ds->frames().size() / std::max(timer.ElapsedSeconds(), 1e-9));
     }
   });
 }

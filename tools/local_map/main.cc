@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   tool.InputFile(
       cli.add_option("--visual", visual_path, "visual.h5 from visual_assoc")->required());
   cli.add_option("--dataset", dataset_dir, "Dataset folder (the scans)")->required();
-  cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
   cli.add_option("--deskew", deskew,
                  "Constant-velocity de-skewing of each keyframe's scan with the prior's motion: "
                  "auto (when the dataset's scans are not motion-compensated: KITTI raw, "

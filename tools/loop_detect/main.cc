@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
-  cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   cli.add_option("--poses", poses_path,
                  "Trajectory of the drive (odometry or prior: .h5 artifact, KITTI or TUM text); "

@@ -37,7 +37,7 @@ class SimMapCheckTest : public ::testing::Test {
     opt.frames = kFrames;
     opt.simulate_scans = false;
     world_ = sim::BuildWorld(opt).release();
-    sim::WriteSequence(*world_, dir_, "00", 2, [] { return io::Provenance{}; });
+    sim::WriteSequence(*world_, io::SequenceLayout{dir_, "00"}, 2, [] { return io::Provenance{}; });
     // What visual_assoc does with --prior poses/00.txt (the ground truth).
     const auto dataset = io::OpenDataset(SequenceDir());
     const mapping::VisualMapOptions options;

@@ -1,6 +1,7 @@
 // sim_sequence: writes a synthetic driving sequence in the KITTI odometry layout
-// (OUT/sequences/NN/{velodyne,image_0,calib.txt,times.txt}, OUT/poses/NN.txt) plus ground truth
-// KITTI lacks: OUT/sequences/NN/sim/{gt_vps.csv, gt_vps.json, scene.json}.
+// (OUT/sequences/NN/{velodyne,image_0,calib.txt,times.txt}, OUT/poses/NN.txt) or the KITTI-360
+// layout (--layout kitti360, io/sim_io.h) plus ground truth KITTI lacks:
+// DATASET/sim/{gt_vps.csv, gt_vps.json, scene.json}.
 #include <spdlog/spdlog.h>
 
 #include <cctype>
@@ -12,19 +13,27 @@
 #include "core/progress.h"
 #include "core/timer.h"
 #include "io/kitti.h"
+#include "io/sim_io.h"
 #include "sim/describe.h"
 #include "sim/preview.h"
 #include "sim/sequence.h"
 #include "sim/write_sequence.h"
 
 int main(int argc, char** argv) {
-  jvl::app::Tool tool("sim_sequence", "Generate a synthetic KITTI-layout driving sequence.");
+  jvl::app::Tool tool("sim_sequence",
+                      "Generate a synthetic driving sequence in the KITTI (or KITTI-360) layout.");
   jvl::sim::SequenceOptions opt;
-  std::string output, sequence = "00", scenario = "urban";
+  std::string output, sequence = "00", scenario = "urban", layout_name = "kitti";
   bool no_images = false, no_scans = false;
   auto& cli = tool.cli();
-  cli.add_option("--output,-o", output, "Output root (KITTI odometry layout)")->required();
+  cli.add_option("--output,-o", output, "Output root (of the dataset layout, --layout)")
+      ->required();
   cli.add_option("--sequence", sequence, "Sequence name (two digits)")->capture_default_str();
+  cli.add_option("--layout", layout_name,
+                 "Dataset layout: kitti (OUT/sequences/NN, OUT/poses/NN.txt) or kitti360 "
+                 "(OUT/calibration, OUT/data_3d_raw/sim_drive_00NN_sync, data_2d_raw, "
+                 "data_poses; the tools' --dataset is OUT/data_3d_raw/sim_drive_00NN_sync)")
+      ->capture_default_str();
   cli.add_option("--frames", opt.frames, "Frames to write (0 = whole route)")
       ->capture_default_str();
   cli.add_option("--scenario", scenario,
@@ -53,15 +62,15 @@ int main(int argc, char** argv) {
     tool.SetDatasetId("sim:" + scenario + ":" + std::to_string(opt.seed));
     jvl::Progress progress("sim_sequence", static_cast<int64_t>(world->ground_truth.size()),
                            !tool.quiet());
+    const jvl::io::SequenceLayout layout{output, sequence, jvl::io::ParseSimLayout(layout_name)};
     const auto st = jvl::sim::WriteSequence(
-        *world, output, sequence, tool.threads(), [&] { return tool.MakeProvenance(); },
+        *world, layout, tool.threads(), [&] { return tool.MakeProvenance(); },
         [&] { progress.Tick(); });
     if (preview >= 0) {
       const auto f = jvl::sim::SimulateFrame(*world, preview);
       char name[64];
-      std::snprintf(name, sizeof(name), "/sequences/%s/sim/topview_%06lld.png", sequence.c_str(),
-                    static_cast<long long>(preview));
-      jvl::io::WriteImage(output + name, jvl::sim::ScanTopView(f.scan, opt.lidar_height));
+      std::snprintf(name, sizeof(name), "/topview_%06lld.png", static_cast<long long>(preview));
+      jvl::io::WriteImage(layout.SimDir() + name, jvl::sim::ScanTopView(f.scan, opt.lidar_height));
     }
     const auto rs = jvl::sim::SummarizeRoute(*world);
     spdlog::info(

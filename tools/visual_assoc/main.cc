@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   mapping::VisualMapOptions options;
   auto& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Dataset folder (KITTI sequence)")->required();
-  cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   tool.InputFile(
       cli.add_option("--prior", prior_path, "Prior trajectory (.h5, KITTI or TUM)")->required());

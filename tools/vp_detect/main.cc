@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
-  cli.add_option("--format", format, "auto, kitti or kitti-raw")->capture_default_str();
+  cli.add_option("--format", format, jvl::io::kDatasetFormatHelp)->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   tool.OutputFile(cli.add_option("-o,--output", output, "Output artifact (vps.h5)")->required());
   tool.OutputFile(cli.add_option("--csv", csv, "Also write one CSV row per VP to this file"));
