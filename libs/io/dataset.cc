@@ -17,6 +17,7 @@
 #include "io/kitti.h"
 #include "io/kitti360.h"
 #include "io/kitti_raw.h"
+#include "io/oxford.h"
 #include "io/trajectory_io.h"
 
 namespace fs = std::filesystem;
@@ -31,6 +32,8 @@ const char* DatasetFormatName(DatasetFormat format) {
       return "kitti-raw";
     case DatasetFormat::kKitti360:
       return "kitti360";
+    case DatasetFormat::kOxford:
+      return "oxford";
     case DatasetFormat::kAuto:
       break;
   }
@@ -42,7 +45,9 @@ DatasetFormat ParseDatasetFormat(const std::string& name) {
   if (name == "kitti") return DatasetFormat::kKittiOdometry;
   if (name == "kitti-raw") return DatasetFormat::kKittiRaw;
   if (name == "kitti360") return DatasetFormat::kKitti360;
-  JVL_THROW("--format: unknown dataset format '" << name << "' (auto, kitti, kitti-raw, kitti360)");
+  if (name == "oxford") return DatasetFormat::kOxford;
+  JVL_THROW("--format: unknown dataset format '" << name
+                                                 << "' (auto, kitti, kitti-raw, kitti360, oxford)");
 }
 
 bool ResolveDeskew(const std::string& mode, const Dataset& dataset) {
@@ -60,6 +65,7 @@ DatasetFormat DetectDatasetFormat(const std::string& dir) {
   const fs::path p(dir);
   // Before KITTI raw: a KITTI-360 data_3d_raw drive folder also holds velodyne_points/data.
   if (LocateKitti360(dir)) return DatasetFormat::kKitti360;
+  if (IsOxfordTraversal(dir)) return DatasetFormat::kOxford;
   if (FileExists((p / "calib.txt").string()) &&
       (IsDirectory((p / "velodyne").string()) || IsDirectory((p / "image_0").string()))) {
     return DatasetFormat::kKittiOdometry;
@@ -68,9 +74,12 @@ DatasetFormat DetectDatasetFormat(const std::string& dir) {
       IsDirectory((p / "oxts" / "data").string())) {
     return DatasetFormat::kKittiRaw;
   }
-  JVL_THROW(dir << ": unknown dataset layout (expected a KITTI odometry sequence folder with "
-                   "calib.txt and velodyne/ or image_0/, a KITTI raw *_sync folder, or a KITTI-360 "
-                   "drive folder ROOT/data_3d_raw/DRIVE with ROOT/calibration/perspective.txt)");
+  JVL_THROW(
+      dir
+      << ": unknown dataset layout (expected a KITTI odometry sequence folder with "
+         "calib.txt and velodyne/ or image_0/, a KITTI raw *_sync folder, or a KITTI-360 "
+         "drive folder ROOT/data_3d_raw/DRIVE with ROOT/calibration/perspective.txt, or an Oxford "
+         "RobotCar traversal with stereo.timestamps and velodyne_left.timestamps)");
 }
 
 std::map<int64_t, std::string> ListNumberedFiles(const std::string& dir, const std::string& ext) {
@@ -281,6 +290,7 @@ std::unique_ptr<Dataset> OpenDataset(const std::string& dir, DatasetFormat forma
   if (format == DatasetFormat::kAuto) format = DetectDatasetFormat(dir);
   if (format == DatasetFormat::kKittiRaw) return OpenKittiRawDataset(dir, range);
   if (format == DatasetFormat::kKitti360) return OpenKitti360Dataset(dir, range);
+  if (format == DatasetFormat::kOxford) return OpenOxfordDataset(dir, range);
   return std::make_unique<KittiOdometryDataset>(dir, range);
 }
 

@@ -1,5 +1,6 @@
 // Datasets named by folder: KITTI odometry sequence folders (also written by sim_sequence),
-// KITTI raw drive folders and KITTI-360 drives (io/kitti360.h). Frames are loaded lazily, one at a
+// KITTI raw drive folders, KITTI-360 drives (io/kitti360.h) and Oxford Radar RobotCar
+// traversals (io/oxford.h). Frames are loaded lazily, one at a
 // time.
 #pragma once
 
@@ -17,12 +18,12 @@
 
 namespace jvl::io {
 
-enum class DatasetFormat { kAuto, kKittiOdometry, kKittiRaw, kKitti360 };
-DatasetFormat ParseDatasetFormat(const std::string& name);  // auto|kitti|kitti-raw|kitti360
+enum class DatasetFormat { kAuto, kKittiOdometry, kKittiRaw, kKitti360, kOxford };
+DatasetFormat ParseDatasetFormat(const std::string& name);  // auto|kitti|kitti-raw|kitti360|oxford
 const char* DatasetFormatName(DatasetFormat format);        // the name ParseDatasetFormat takes
 // Help text of the tools' --format option.
 inline constexpr const char* kDatasetFormatHelp =
-    "Dataset layout: auto (detected from the folder), kitti, kitti-raw or kitti360";
+    "Dataset layout: auto (detected from the folder), kitti, kitti-raw, kitti360 or oxford";
 
 class Dataset {
  public:
