@@ -106,9 +106,12 @@ class OxfordDataset : public Dataset {
  public:
   OxfordDataset(const std::string& dir, const FrameRange& range) {
     format_ = DatasetFormat::kOxford;
-    scans_motion_compensated_ = false;  // the SDK: the scans are not motion-compensated
     root_ = dir;
     const fs::path p(dir);
+    // The SDK: the scans are not motion-compensated. A traversal written by sim_sequence says
+    // in its sim/scene.json whether the LiDAR moved during the sweep.
+    const std::string scene = (p / "sim" / "scene.json").string();
+    scans_motion_compensated_ = FileExists(scene) && !SimulatedWithMotionDistortion(scene);
     JVL_CHECK(IsOxfordTraversal(dir), dir << ": not an Oxford RobotCar traversal (expected "
                                              "stereo.timestamps and velodyne_left.timestamps)");
     const std::string cam_stamps = (p / "stereo.timestamps").string();

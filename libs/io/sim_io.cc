@@ -2,12 +2,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
 
 #include "core/check.h"
+#include "core/strings.h"
 #include "io/files.h"
 #include "io/kitti.h"
 #include "io/trajectory_io.h"
@@ -39,26 +41,41 @@ std::string FormatDouble(double v, const char* fmt) {
 SimLayout ParseSimLayout(const std::string& name) {
   if (name == "kitti") return SimLayout::kKitti;
   if (name == "kitti360") return SimLayout::kKitti360;
-  JVL_THROW("--layout: unknown layout '" << name << "' (kitti, kitti360)");
+  if (name == "oxford") return SimLayout::kOxford;
+  JVL_THROW("--layout: unknown layout '" << name << "' (kitti, kitti360, oxford)");
 }
 
-std::string SequenceLayout::Drive() const { return "sim_drive_00" + sequence + "_sync"; }
+int64_t SequenceLayout::OxfordTime(int64_t frame) const {
+  JVL_CHECK(frame >= 0 && frame < static_cast<int64_t>(times.size()),
+            "Oxford layout: no timestamp for frame " << frame);
+  return kOxfordSimEpochUs + std::llround(1e6 * times[static_cast<size_t>(frame)]);
+}
+std::string SequenceLayout::Drive() const {
+  if (layout == SimLayout::kOxford) return "sim-oxford-" + sequence;
+  return "sim_drive_00" + sequence + "_sync";
+}
 std::string SequenceLayout::SequenceDir() const {
   if (layout == SimLayout::kKitti360) return root + "/data_3d_raw/" + Drive();
+  if (layout == SimLayout::kOxford) return root + "/" + Drive();
   return root + "/sequences/" + sequence;
 }
 std::string SequenceLayout::ScanPath(int64_t f) const {
+  if (layout == SimLayout::kOxford)
+    return SequenceDir() + "/velodyne_left/" + std::to_string(OxfordTime(f)) + ".bin";
   if (layout == SimLayout::kKitti360)
     return SequenceDir() + "/velodyne_points/data/" + Numbered10(f, ".bin");
   return SequenceDir() + "/velodyne/" + Numbered(f, ".bin");
 }
 std::string SequenceLayout::ImagePath(int64_t f) const {
+  if (layout == SimLayout::kOxford)
+    return SequenceDir() + "/stereo/centre/" + std::to_string(OxfordTime(f)) + ".png";
   if (layout == SimLayout::kKitti360) {
     return root + "/data_2d_raw/" + Drive() + "/image_00/data_rect/" + Numbered10(f, ".png");
   }
   return SequenceDir() + "/image_0/" + Numbered(f, ".png");
 }
 std::string SequenceLayout::PosesPath() const {
+  if (layout == SimLayout::kOxford) return SequenceDir() + "/gps/ins.csv";
   if (layout == SimLayout::kKitti360) return root + "/data_poses/" + Drive() + "/cam0_to_world.txt";
   return root + "/poses/" + sequence + ".txt";
 }
@@ -132,11 +149,101 @@ void WriteKitti360Metadata(const SequenceLayout& layout, const Calibration& cali
   WriteTextFileAtomic(poses_dir + "/poses.txt", imu_poses);
 }
 
+// x y z roll pitch yaw of a rigid transform, R = Rz(yaw) Ry(pitch) Rx(roll).
+std::string FormatXyzRpy(const Rigid3d& t) {
+  const Eigen::Matrix3d r = t.RotationMatrix();
+  const double yaw = std::atan2(r(1, 0), r(0, 0));
+  const double pitch = std::atan2(-r(2, 0), std::hypot(r(0, 0), r(1, 0)));
+  const double roll = std::atan2(r(2, 1), r(2, 2));
+  std::string out;
+  for (double v : {t.translation().x(), t.translation().y(), t.translation().z(), roll, pitch, yaw})
+    out += (out.empty() ? "" : " ") + FormatDouble(v, "%.17g");
+  return out;
+}
+
+void WriteOxfordMetadata(const SequenceLayout& layout, const Calibration& calib,
+                         const Trajectory& gt) {
+  JVL_CHECK(layout.times.size() == gt.size() && gt.frames.front() == 0,
+            "Oxford layout: every frame's time from frame 0 is needed");
+  const std::string dir = layout.SequenceDir();
+  for (const std::string& d : {dir + "/stereo/centre", dir + "/velodyne_left", dir + "/gps",
+                               layout.root + "/models", layout.root + "/extrinsics"})
+    CreateDirectories(d);
+  // The vehicle frame is camera 0's base frame: x forward, y right, z down.
+  Eigen::Matrix3d vehicle_from_optical;
+  vehicle_from_optical << 0, 0, 1, 1, 0, 0, 0, 1, 0;
+  const PinholeCamera cam = calib.Camera(0);
+  std::string model = FormatDouble(cam.fx, "%.17g") + " " + FormatDouble(cam.fy, "%.17g") + " " +
+                      FormatDouble(cam.cx, "%.17g") + " " + FormatDouble(cam.cy, "%.17g") + "\n";
+  model += "0 0 1 0\n1 0 0 0\n0 1 0 0\n0 0 0 1\n";  // G_camera_image = vehicle_from_optical
+  WriteTextFileAtomic(layout.root + "/models/stereo_narrow_left.txt", model);
+  const int w = calib.image_width, h = calib.image_height;
+  JVL_CHECK(w > 0 && h > 0, "Oxford layout: the image size is needed");
+  std::string lut(16 * static_cast<size_t>(w) * h, '\0');
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      const double u = c, v = r;
+      const size_t i = static_cast<size_t>(r) * w + c;
+      std::memcpy(lut.data() + 8 * i, &u, 8);
+      std::memcpy(lut.data() + 8 * (static_cast<size_t>(w) * h + i), &v, 8);
+    }
+  }
+  WriteTextFileAtomic(layout.root + "/models/stereo_narrow_left_distortion_lut.bin", lut);
+  const Rigid3d vehicle_from_cam0(vehicle_from_optical, Eigen::Vector3d::Zero());
+  WriteTextFileAtomic(layout.root + "/extrinsics/velodyne_left.txt",
+                      FormatXyzRpy(vehicle_from_cam0 * calib.cam0_from_velo) + "\n");
+  WriteTextFileAtomic(layout.root + "/extrinsics/ins.txt", "0 0 0 0 0 0\n");
+  WriteTextFileAtomic(layout.root + "/extrinsics/stereo.txt", "0 0 0 0 0 0\n");
+  std::string stamps;
+  std::string ins =
+      "timestamp,ins_status,latitude,longitude,altitude,northing,easting,down,utm_zone,"
+      "velocity_north,velocity_east,velocity_down,roll,pitch,yaw\n";
+  const Rigid3d cam0_from_vehicle = vehicle_from_cam0.Inverse();
+  for (size_t i = 0; i < gt.size(); ++i) {
+    const int64_t t = layout.OxfordTime(gt.frames[i]);
+    stamps += std::to_string(t) + " 1\n";
+    // The INS at the vehicle origin, in a north-east-down world that is the vehicle frame of
+    // frame 0 (level poses stay far from the Euler angles' singularity at pitch +-90 deg):
+    // P_ins = vehicle_from_cam0 * world_from_cam0 * cam0_from_vehicle.
+    const Rigid3d p = vehicle_from_cam0 * gt.world_from_cam[i] * cam0_from_vehicle;
+    std::string row = FormatXyzRpy(p);
+    std::vector<std::string> v;
+    for (auto tok : SplitWhitespace(row)) v.emplace_back(tok);
+    ins += std::to_string(t) + ",INS_SOLUTION_GOOD,0,0,0," + v[0] + "," + v[1] + "," + v[2] +
+           ",30U,0,0,0," + v[3] + "," + v[4] + "," + v[5] + "\n";
+  }
+  WriteTextFileAtomic(dir + "/stereo.timestamps", stamps);
+  WriteTextFileAtomic(dir + "/velodyne_left.timestamps", stamps);
+  WriteTextFileAtomic(layout.PosesPath(), ins);
+}
+
 }  // namespace
+
+void WriteSequenceScan(const SequenceLayout& layout, int64_t frame, const PointCloud& cloud) {
+  if (layout.layout != SimLayout::kOxford) {
+    WriteVelodyneBin(layout.ScanPath(frame), cloud);
+    return;
+  }
+  const size_t n = cloud.size();
+  std::vector<float> v(4 * n);
+  for (size_t i = 0; i < n; ++i) {
+    v[i] = static_cast<float>(cloud.points[i].x());
+    v[n + i] = static_cast<float>(cloud.points[i].y());
+    v[2 * n + i] = static_cast<float>(cloud.points[i].z());
+    v[3 * n + i] = cloud.intensity.empty() ? 0.0f : 255.0f * cloud.intensity[i];
+  }
+  std::string bytes(16 * n, '\0');
+  std::memcpy(bytes.data(), v.data(), bytes.size());
+  WriteTextFileAtomic(layout.ScanPath(frame), bytes);
+}
 
 void WriteSequenceMetadata(const SequenceLayout& layout, const Calibration& calib,
                            const Trajectory& gt) {
   gt.Check("ground truth");
+  if (layout.layout == SimLayout::kOxford) {
+    WriteOxfordMetadata(layout, calib, gt);
+    return;
+  }
   if (layout.layout == SimLayout::kKitti360) {
     WriteKitti360Metadata(layout, calib, gt);
     return;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/calibration.h"
@@ -21,15 +22,25 @@ namespace jvl::io {
 enum class SimLayout {
   kKitti,     // ROOT/sequences/NN/{calib.txt, times.txt, velodyne/, image_0/}, ROOT/poses/NN.txt
   kKitti360,  // ROOT/calibration/, ROOT/data_3d_raw/DRIVE, data_2d_raw/DRIVE, data_poses/DRIVE
+  kOxford,    // ROOT/sim-oxford-NN/{stereo/centre, velodyne_left, *.timestamps, gps/ins.csv},
+              // ROOT/{extrinsics, models}
 };
-SimLayout ParseSimLayout(const std::string& name);  // kitti | kitti360
+SimLayout ParseSimLayout(const std::string& name);  // kitti | kitti360 | oxford
 
 // Paths of a simulated sequence `sequence` ("00") in `layout` rooted at `root`. KITTI-360 names
-// the drive sim_drive_00NN_sync (the sequence as a four-digit drive number).
+// the drive sim_drive_00NN_sync (the sequence as a four-digit drive number), Oxford the
+// traversal sim-oxford-NN; Oxford's file names are the frames' times in µs (kOxfordSimEpochUs +
+// `times`, which must then hold every frame's timestamp).
+inline constexpr int64_t kOxfordSimEpochUs = 1547131008000000;  // 2019-01-10 14:36:48 UTC
 struct SequenceLayout {
+  SequenceLayout(std::string root_dir, std::string sequence_name,
+                 SimLayout kind = SimLayout::kKitti)
+      : root(std::move(root_dir)), sequence(std::move(sequence_name)), layout(kind) {}
   std::string root, sequence;
   SimLayout layout = SimLayout::kKitti;
-  std::string Drive() const;                   // KITTI-360 drive folder name
+  std::vector<double> times;                   // frame timestamps (s); Oxford only
+  int64_t OxfordTime(int64_t frame) const;     // µs since 1970
+  std::string Drive() const;                   // KITTI-360 drive / Oxford traversal folder name
   std::string SequenceDir() const;             // what the tools' --dataset takes
   std::string ScanPath(int64_t frame) const;   // velodyne/000000.bin, .../data/0000000000.bin
   std::string ImagePath(int64_t frame) const;  // image_0/000000.png, .../data_rect/0000000000.png
@@ -42,8 +53,14 @@ struct SequenceLayout {
 // (P_rect_00/01, R_rect_00 = identity, S_rect_00 = the image size), calib_cam_to_velo.txt,
 // calib_cam_to_pose.txt (the pose frame is the Velodyne's), timestamps.txt of the Velodyne and of
 // camera 0 (from 2013-01-01 00:00:00), cam0_to_world.txt and poses.txt.
+// Oxford: the SDK's files for the simulated rig in ROOT (models/stereo_narrow_left.txt with
+// G_camera_image, an identity undistortion table, extrinsics/ with the vehicle frame at camera
+// 0 and the INS there), stereo.timestamps and velodyne_left.timestamps (the same times: the
+// simulator's camera and LiDAR are synchronous), gps/ins.csv at the frame times.
 void WriteSequenceMetadata(const SequenceLayout& layout, const Calibration& calib,
                            const Trajectory& ground_truth);
+// A scan in the layout's format (Oxford: planar float32, intensities 0-255).
+void WriteSequenceScan(const SequenceLayout& layout, int64_t frame, const PointCloud& cloud);
 
 // One ground-truth vanishing point (see sim/ground_truth.h).
 struct GtVpRow {

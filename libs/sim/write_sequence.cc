@@ -9,16 +9,18 @@
 
 namespace jvl::sim {
 
-WriteStats WriteSequence(const World& world, const io::SequenceLayout& layout, int threads,
+WriteStats WriteSequence(const World& world, const io::SequenceLayout& layout_in, int threads,
                          const std::function<io::Provenance()>& provenance,
                          const std::function<void()>& tick) {
   const SequenceOptions& opt = world.options;
+  io::SequenceLayout layout = layout_in;
+  layout.times = world.ground_truth.timestamps;
   io::WriteSequenceMetadata(layout, opt.calibration, world.ground_truth);
   std::vector<std::vector<io::GtVpRow>> vps(world.ground_truth.size());
   std::atomic<int64_t> points{0};
   Timer timer;
   GenerateSequence(world, threads, [&](SimFrame&& f) {
-    if (opt.simulate_scans) io::WriteVelodyneBin(layout.ScanPath(f.frame), f.scan);
+    if (opt.simulate_scans) io::WriteSequenceScan(layout, f.frame, f.scan);
     if (opt.render_images) io::WriteImage(layout.ImagePath(f.frame), f.image);
     points += static_cast<int64_t>(f.scan.size());
     const size_t slot = *world.ground_truth.IndexOf(f.frame);

@@ -1,12 +1,22 @@
-// The same simulated drive written in the KITTI odometry layout (run_a) and in the KITTI-360
-// layout (run_k360, tests/robustness/pipeline.sh ... kitti360) goes through the whole chain to the
-// same trajectories and metrics: the readers give the tools the same frames, timestamps,
-// calibration, scans, images and ground truth. The calibration's numbers are written with 12
+// The same simulated drive written in the KITTI odometry layout (run_a), in the KITTI-360 layout
+// (run_k360) and in the Oxford RobotCar layout (run_oxford; tests/robustness/pipeline.sh ...
+// LAYOUT) goes through the whole chain.
+//
+// KITTI-360: the reader gives the tools the same frames, timestamps, calibration, scans, images
+// and ground truth, so the results are the same. The calibration's numbers are written with 12
 // (calib.txt) and 17 (KITTI-360 files) significant digits, so the poses may differ in the last
 // bits: measured 1.5e-13 (odometry), 5.3e-13 (local_map) and 2.3e-12 (global_opt); the
 // tolerance is 1e-9.
+//
+// Oxford: the same world, but the scans come in the LiDAR frame turned to the vehicle's axes
+// (the simulated LiDAR is rotated by a fraction of a degree against them, so voxel grids and
+// neighbourhoods fall differently) and the images are demosaiced from a Bayer mosaic (a
+// bilinear blur). The results agree within the chain's own noise: measured at most 6.6 mm
+// (odometry), 16 mm (local_map) and 20 mm (global_opt) apart, translation APE 1.03-1.07x of the
+// KITTI layout's. Tolerances: 50 mm, and 0.7-1.4x.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -23,47 +33,66 @@ constexpr double kTolerance = 1e-9;
 class LayoutTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    for (const std::string run : {"run_a", "run_k360"}) {
+    for (const std::string run : {"run_a", "run_k360", "run_oxford"}) {
       if (!io::FileExists(kDir + run + "/metrics.json"))
-        GTEST_SKIP() << kDir << run << " incomplete (robust_pipeline_a / _k360 make it)";
+        GTEST_SKIP() << kDir << run << " incomplete (robust_pipeline_a / _k360 / _oxford make it)";
     }
   }
 };
 
-TEST_F(LayoutTest, KittiAndKitti360LayoutsGiveTheSameTrajectories) {
-  for (const std::string name : {"odom.txt", "local.txt", "global.txt"}) {
-    const Trajectory a = io::ReadTrajectory(kDir + "run_a/" + name, io::TrajectoryFormat::kAuto);
-    const Trajectory b = io::ReadTrajectory(kDir + "run_k360/" + name, io::TrajectoryFormat::kAuto);
-    ASSERT_EQ(a.frames, b.frames) << name;
-    ASSERT_GT(a.size(), 10u) << name;
-    double worst = 0;
-    for (size_t i = 0; i < a.size(); ++i) {
-      worst = std::max(worst, (a.world_from_cam[i].Matrix3x4() - b.world_from_cam[i].Matrix3x4())
-                                  .cwiseAbs()
-                                  .maxCoeff());
-    }
-    EXPECT_LT(worst, kTolerance) << name;
+// The largest difference of a pose matrix entry between run_a's and `run`'s trajectory `name`.
+double LargestDifference(const std::string& run, const std::string& name) {
+  const Trajectory a = io::ReadTrajectory(kDir + "run_a/" + name, io::TrajectoryFormat::kAuto);
+  const Trajectory b = io::ReadTrajectory(kDir + run + "/" + name, io::TrajectoryFormat::kAuto);
+  EXPECT_EQ(a.frames, b.frames) << run << " " << name;
+  EXPECT_GT(a.size(), 10u) << name;
+  double worst = 0;
+  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    worst = std::max(
+        worst,
+        (a.world_from_cam[i].Matrix3x4() - b.world_from_cam[i].Matrix3x4()).cwiseAbs().maxCoeff());
   }
+  return worst;
+}
+
+nlohmann::json LoadMetrics(const std::string& run) {
+  std::ifstream in(kDir + run + "/metrics.json");
+  return nlohmann::json::parse(in);
+}
+
+// APE RMSE (translation m or rotation deg) of estimate i of a metrics file.
+double Ape(const nlohmann::json& metrics, size_t i, const char* field) {
+  return metrics.at("estimates").at(i).at("ape").at(field).at("rmse").get<double>();
+}
+
+TEST_F(LayoutTest, KittiAndKitti360LayoutsGiveTheSameTrajectories) {
+  for (const std::string name : {"odom.txt", "local.txt", "global.txt"})
+    EXPECT_LT(LargestDifference("run_k360", name), kTolerance) << name;
 }
 
 TEST_F(LayoutTest, KittiAndKitti360LayoutsGiveTheSameMetrics) {
-  auto load = [](const std::string& run) {
-    std::ifstream in(kDir + run + "/metrics.json");
-    return nlohmann::json::parse(in);
-  };
-  const nlohmann::json a = load("run_a"), b = load("run_k360");
-  ASSERT_EQ(a.at("estimates").size(), b.at("estimates").size());
-  ASSERT_EQ(a["estimates"].size(), 4u);
-  for (size_t i = 0; i < a["estimates"].size(); ++i) {
-    const auto& ea = a["estimates"][i];
-    const auto& eb = b["estimates"][i];
-    EXPECT_EQ(ea["label"], eb["label"]);
-    EXPECT_EQ(ea.at("frames_matched"), eb.at("frames_matched")) << ea["label"];
-    for (const char* field : {"translation_m", "rotation_deg"}) {
-      const double va = ea.at("ape").at(field).at("rmse").get<double>();
-      const double vb = eb.at("ape").at(field).at("rmse").get<double>();
-      EXPECT_NEAR(va, vb, kTolerance) << ea["label"] << " APE " << field;
-    }
+  const nlohmann::json a = LoadMetrics("run_a"), b = LoadMetrics("run_k360");
+  ASSERT_EQ(a.at("estimates").size(), 4u);
+  ASSERT_EQ(b.at("estimates").size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(a["estimates"][i].at("label"), b["estimates"][i].at("label"));
+    EXPECT_EQ(a["estimates"][i].at("frames_matched"), b["estimates"][i].at("frames_matched"));
+    for (const char* field : {"translation_m", "rotation_deg"})
+      EXPECT_NEAR(Ape(a, i, field), Ape(b, i, field), kTolerance) << i << " " << field;
+  }
+}
+
+TEST_F(LayoutTest, OxfordLayoutGivesTheSameResultsWithinTheChainsNoise) {
+  for (const std::string name : {"odom.txt", "local.txt", "global.txt"})
+    EXPECT_LT(LargestDifference("run_oxford", name), 0.05) << name;
+  const nlohmann::json a = LoadMetrics("run_a"), b = LoadMetrics("run_oxford");
+  ASSERT_EQ(a.at("estimates").size(), 4u);
+  ASSERT_EQ(b.at("estimates").size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(a["estimates"][i].at("frames_matched"), b["estimates"][i].at("frames_matched"));
+    const double ratio = Ape(b, i, "translation_m") / Ape(a, i, "translation_m");
+    EXPECT_GT(ratio, 0.7) << a["estimates"][i].at("label");
+    EXPECT_LT(ratio, 1.4) << a["estimates"][i].at("label");
   }
 }
 

@@ -6,8 +6,8 @@
 #
 #   tests/robustness/pipeline.sh BIN_DIR OUT_DIR THREADS [FRAMES] [LAYOUT]
 #
-# LAYOUT: kitti (default) or kitti360 (the same drive written in the KITTI-360 layout; the
-# ground truth comes from dataset_info --write-gt).
+# LAYOUT: kitti (default), kitti360 or oxford (the same drive written in the KITTI-360 or the
+# Oxford RobotCar layout; the ground truth comes from dataset_info --write-gt).
 set -euo pipefail
 
 bin=$(cd "$1" && pwd)
@@ -22,8 +22,8 @@ cd "$out"
 common=(--threads "$threads" --log-level warn)
 "$bin/sim_sequence" -o data --sequence 00 --seed 1 --frames "$frames" --layout "$layout" --quiet \
   "${common[@]}"
-if [[ $layout == kitti360 ]]; then
-  seq=data/data_3d_raw/sim_drive_0000_sync
+if [[ $layout != kitti ]]; then
+  if [[ $layout == kitti360 ]]; then seq=data/data_3d_raw/sim_drive_0000_sync; else seq=data/sim-oxford-00; fi
   gt=gt.txt
   "$bin/dataset_info" --dataset "$seq" --write-gt "$gt" --quiet "${common[@]}" > /dev/null
 else

@@ -30,9 +30,11 @@ int main(int argc, char** argv) {
       ->required();
   cli.add_option("--sequence", sequence, "Sequence name (two digits)")->capture_default_str();
   cli.add_option("--layout", layout_name,
-                 "Dataset layout: kitti (OUT/sequences/NN, OUT/poses/NN.txt) or kitti360 "
+                 "Dataset layout: kitti (OUT/sequences/NN, OUT/poses/NN.txt), kitti360 "
                  "(OUT/calibration, OUT/data_3d_raw/sim_drive_00NN_sync, data_2d_raw, "
-                 "data_poses; the tools' --dataset is OUT/data_3d_raw/sim_drive_00NN_sync)")
+                 "data_poses; the tools' --dataset is OUT/data_3d_raw/sim_drive_00NN_sync) or "
+                 "oxford (OUT/sim-oxford-NN, the tools' --dataset, with OUT/extrinsics and "
+                 "OUT/models)")
       ->capture_default_str();
   cli.add_option("--frames", opt.frames, "Frames to write (0 = whole route)")
       ->capture_default_str();
