@@ -112,27 +112,12 @@ class Kitti360Dataset : public Dataset {
     const std::string c2p = (root / "calibration" / "calib_cam_to_pose.txt").string();
     key_files_ = {persp, c2v};
     const auto cam = ReadKeyValues(persp, kCalibHint);
-    for (int i = 0; i < 2; ++i) {
-      const std::string key = "P_rect_0" + std::to_string(i);
-      if (i == 1 && !cam.count(key)) continue;
-      const auto& v = RequireValues(cam, key, 12, persp);
-      for (int k = 0; k < 12; ++k) {
-        JVL_CHECK(std::isfinite(v[k]), persp << ": " << key << " has a non-finite value");
-        calibration_.P[i](k / 4, k % 4) = v[k];
-      }
-    }
+    const Rigid3d rect_from_cam0 =
+        ReadRectification(cam, persp, 1, 1, &calibration_, &image_size_source_);
     JVL_CHECK(calibration_.P[0](0, 0) > 0 && calibration_.P[0](1, 1) > 0,
               persp << ": P_rect_00 has no positive focal length");
-    const Rigid3d rect_from_cam0 =
-        RigidFromRT(RequireValues(cam, "R_rect_00", 9, persp), {0, 0, 0}, persp);
-    const auto& size = RequireValues(cam, "S_rect_00", 2, persp);
-    JVL_CHECK(size[0] >= 1 && size[0] <= 1e5 && size[1] >= 1 && size[1] <= 1e5,
-              persp << ": S_rect_00 is not an image size");
-    calibration_.image_width = static_cast<int>(size[0]);
-    calibration_.image_height = static_cast<int>(size[1]);
-    image_size_source_ = persp + ", S_rect_00";
     JVL_CHECK(FileExists(c2v), c2v << ": calibration file not found (" << kCalibHint << ")");
-    const Rigid3d velo_from_cam0 = RigidFrom3x4(ReadNumbers(c2v), c2v);
+    const Rigid3d velo_from_cam0 = RigidFrom3x4(ReadNumberFile(c2v), c2v);
     calibration_.cam0_from_velo = rect_from_cam0 * velo_from_cam0.Inverse();
 
     scans_ = ListNumberedFiles((velo_dir_ / "data").string(), ".bin");
@@ -210,35 +195,18 @@ class Kitti360Dataset : public Dataset {
                             image_size_source_);
   }
   std::string ScanPath(int64_t frame) const override {
-    return (velo_dir_ / "data" / Name(frame, ".bin")).string();
+    return (velo_dir_ / "data" / ZeroPaddedName(frame, 10, ".bin")).string();
   }
   std::string ImagePath(int64_t frame, int camera) const override {
     // Cameras 2 and 3 are the fisheyes (data_rgb); listed so that no tool ever writes there.
     const char* sub = camera < 2 ? "data_rect" : "data_rgb";
-    return (image_root_ / ("image_0" + std::to_string(camera)) / sub / Name(frame, ".png"))
+    return (image_root_ / ("image_0" + std::to_string(camera)) / sub /
+            ZeroPaddedName(frame, 10, ".png"))
         .string();
   }
   std::vector<std::string> KeyFiles() const override { return key_files_; }
 
  private:
-  static std::string Name(int64_t frame, const char* ext) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "%010lld%s", static_cast<long long>(frame), ext);
-    return name;
-  }
-  // The numbers of a file holding only numbers (calib_cam_to_velo.txt: 12 on one line).
-  static std::vector<double> ReadNumbers(const std::string& path) {
-    std::vector<double> values;
-    for (const auto& line : ReadLines(path)) {
-      for (auto tok : SplitWhitespace(line)) {
-        const auto v = ParseDouble(tok);
-        JVL_CHECK(v && std::isfinite(*v), path << ": bad value '" << tok << "'");
-        values.push_back(*v);
-      }
-    }
-    return values;
-  }
-
   std::string drive_;
   fs::path velo_dir_, image_root_;
   std::map<int64_t, std::string> scans_;

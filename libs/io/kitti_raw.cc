@@ -84,21 +84,8 @@ class KittiRawDataset : public Dataset {
     const std::string i2v = (date_dir / "calib_imu_to_velo.txt").string();
     key_files_ = {c2c, v2c, i2v};
     const auto cam = ReadKeyValues(c2c, kCalibHint);
-    for (int i = 0; i < 4; ++i) {
-      const auto& v = RequireValues(cam, "P_rect_0" + std::to_string(i), 12, c2c);
-      for (int k = 0; k < 12; ++k) {
-        JVL_CHECK(std::isfinite(v[k]), c2c << ": P_rect_0" << i << " has a non-finite value");
-        calibration_.P[i](k / 4, k % 4) = v[k];
-      }
-    }
-    const auto& rr = RequireValues(cam, "R_rect_00", 9, c2c);
-    const Rigid3d rect_from_cam0 = RigidFromRT(rr, {0, 0, 0}, c2c);
-    const auto& size = RequireValues(cam, "S_rect_00", 2, c2c);
-    JVL_CHECK(size[0] >= 1 && size[0] <= 1e5 && size[1] >= 1 && size[1] <= 1e5,
-              c2c << ": S_rect_00 is not an image size");
-    calibration_.image_width = static_cast<int>(size[0]);
-    calibration_.image_height = static_cast<int>(size[1]);
-    image_size_source_ = c2c + ", S_rect_00";
+    const Rigid3d rect_from_cam0 =
+        ReadRectification(cam, c2c, 4, 0, &calibration_, &image_size_source_);
     const auto velo = ReadKeyValues(v2c, kCalibHint);
     const Rigid3d cam0_from_velo_unrect =
         RigidFromRT(RequireValues(velo, "R", 9, v2c), RequireValues(velo, "T", 3, v2c), v2c);
@@ -164,14 +151,13 @@ class KittiRawDataset : public Dataset {
                             image_size_source_);
   }
   std::string ScanPath(int64_t frame) const override {
-    char name[32];
-    std::snprintf(name, sizeof(name), "%010lld.bin", static_cast<long long>(frame));
-    return (fs::path(root_) / "velodyne_points" / "data" / name).string();
+    return (fs::path(root_) / "velodyne_points" / "data" / ZeroPaddedName(frame, 10, ".bin"))
+        .string();
   }
   std::string ImagePath(int64_t frame, int camera) const override {
-    char name[32];
-    std::snprintf(name, sizeof(name), "%010lld.png", static_cast<long long>(frame));
-    return (fs::path(root_) / ("image_0" + std::to_string(camera)) / "data" / name).string();
+    return (fs::path(root_) / ("image_0" + std::to_string(camera)) / "data" /
+            ZeroPaddedName(frame, 10, ".png"))
+        .string();
   }
   std::vector<std::string> KeyFiles() const override { return key_files_; }
 

@@ -1,6 +1,7 @@
 #include "io/kitti_text.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 
 #include "core/check.h"
@@ -70,6 +71,47 @@ std::vector<std::string> ReadLines(const std::string& path) {
     if (!Trim(line).empty()) lines.push_back(line);
   }
   return lines;
+}
+
+std::vector<double> ReadNumberFile(const std::string& path) {
+  std::vector<double> values;
+  for (const auto& line : ReadLines(path)) {
+    for (auto tok : SplitWhitespace(line)) {
+      const auto v = ParseDouble(tok);
+      JVL_CHECK(v && std::isfinite(*v), path << ": bad value '" << tok << "'");
+      values.push_back(*v);
+    }
+  }
+  return values;
+}
+
+std::string ZeroPaddedName(int64_t frame, int digits, const char* ext) {
+  char name[48];
+  std::snprintf(name, sizeof(name), "%0*lld%s", digits, static_cast<long long>(frame), ext);
+  return name;
+}
+
+Rigid3d ReadRectification(const std::map<std::string, std::vector<double>>& kv,
+                          const std::string& path, int required, int optional, Calibration* calib,
+                          std::string* size_source) {
+  for (int i = 0; i < required + optional; ++i) {
+    const std::string key = "P_rect_0" + std::to_string(i);
+    if (i >= required && !kv.count(key)) continue;
+    const auto& v = RequireValues(kv, key, 12, path);
+    for (int k = 0; k < 12; ++k) {
+      JVL_CHECK(std::isfinite(v[k]), path << ": " << key << " has a non-finite value");
+      calib->P[i](k / 4, k % 4) = v[k];
+    }
+  }
+  const Rigid3d rect_from_cam0 =
+      RigidFromRT(RequireValues(kv, "R_rect_00", 9, path), {0, 0, 0}, path);
+  const auto& size = RequireValues(kv, "S_rect_00", 2, path);
+  JVL_CHECK(size[0] >= 1 && size[0] <= 1e5 && size[1] >= 1 && size[1] <= 1e5,
+            path << ": S_rect_00 is not an image size");
+  calib->image_width = static_cast<int>(size[0]);
+  calib->image_height = static_cast<int>(size[1]);
+  *size_source = path + ", S_rect_00";
+  return rect_from_cam0;
 }
 
 }  // namespace jvl::io

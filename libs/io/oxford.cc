@@ -27,6 +27,16 @@ Rigid3d OxfordSe3(double x, double y, double z, double roll, double pitch, doubl
   return Rigid3d(r, Eigen::Vector3d(x, y, z));
 }
 
+std::array<double, 6> OxfordXyzRpy(const Rigid3d& t) {
+  const Eigen::Matrix3d r = t.RotationMatrix();
+  return {t.translation().x(),
+          t.translation().y(),
+          t.translation().z(),
+          std::atan2(r(2, 1), r(2, 2)),
+          std::atan2(-r(2, 0), std::hypot(r(0, 0), r(1, 0))),
+          std::atan2(r(1, 0), r(0, 0))};
+}
+
 std::vector<int64_t> ReadOxfordTimestamps(const std::string& path) {
   std::vector<int64_t> times;
   const auto lines = ReadLines(path);
@@ -79,22 +89,9 @@ bool IsOxfordTraversal(const std::string& dir) {
 
 namespace {
 
-// The numbers of a whitespace-separated text file.
-std::vector<double> ReadNumbers(const std::string& path) {
-  std::vector<double> values;
-  for (const auto& line : ReadLines(path)) {
-    for (auto tok : SplitWhitespace(line)) {
-      const auto v = ParseDouble(tok);
-      JVL_CHECK(v && std::isfinite(*v), path << ": bad value '" << tok << "'");
-      values.push_back(*v);
-    }
-  }
-  return values;
-}
-
 Rigid3d ReadExtrinsic(const std::string& path) {
   JVL_CHECK(FileExists(path), path << ": extrinsics file not found");
-  const auto v = ReadNumbers(path);
+  const auto v = ReadNumberFile(path);
   JVL_CHECK(v.size() == 6, path << ": " << v.size() << " numbers, expected x y z roll pitch yaw");
   return OxfordSe3(v[0], v[1], v[2], v[3], v[4], v[5]);
 }
@@ -140,7 +137,7 @@ class OxfordDataset : public Dataset {
 
     // Camera: line 1 fx fy cx cy, then G_camera_image (optical frame -> camera base frame,
     // x forward, y right, z down). The stereo camera is the vehicle frame (stereo.txt is zero).
-    const auto m = ReadNumbers(model);
+    const auto m = ReadNumberFile(model);
     JVL_CHECK(m.size() == 20,
               model << ": " << m.size() << " numbers, expected fx fy cx cy and a 4 x 4 matrix");
     JVL_CHECK(m[0] > 0 && m[1] > 0, model << ": focal lengths must be positive");

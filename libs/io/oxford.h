@@ -13,6 +13,7 @@
 // the image times (SLERP, linear translation), as world_from_cam0 relative to the first frame.
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <string>
@@ -28,6 +29,8 @@ inline constexpr double kOxfordMaxPairGapS = 0.04;  // half a 20 Hz sweep and so
 
 // The SDK's x y z roll pitch yaw (m, rad) as a rigid transform, R = Rz(yaw) Ry(pitch) Rx(roll).
 Rigid3d OxfordSe3(double x, double y, double z, double roll, double pitch, double yaw);
+// Its inverse: x y z roll pitch yaw of a rigid transform (pitch within +-90 deg).
+std::array<double, 6> OxfordXyzRpy(const Rigid3d& t);
 
 // The timestamps (µs since 1970) of a <sensor>.timestamps file ("<t> <chunk>" lines).
 std::vector<int64_t> ReadOxfordTimestamps(const std::string& path);

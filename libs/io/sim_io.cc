@@ -9,25 +9,14 @@
 #include <sstream>
 
 #include "core/check.h"
-#include "core/strings.h"
 #include "io/files.h"
 #include "io/kitti.h"
+#include "io/kitti_text.h"
+#include "io/oxford.h"
 #include "io/trajectory_io.h"
 
 namespace jvl::io {
 namespace {
-
-std::string Numbered(int64_t frame, const char* ext) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%06lld%s", static_cast<long long>(frame), ext);
-  return buf;
-}
-
-std::string Numbered10(int64_t frame, const char* ext) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%010lld%s", static_cast<long long>(frame), ext);
-  return buf;
-}
 
 std::string FormatDouble(double v, const char* fmt) {
   if (!std::isfinite(v)) return "nan";
@@ -63,16 +52,17 @@ std::string SequenceLayout::ScanPath(int64_t f) const {
   if (layout == SimLayout::kOxford)
     return SequenceDir() + "/velodyne_left/" + std::to_string(OxfordTime(f)) + ".bin";
   if (layout == SimLayout::kKitti360)
-    return SequenceDir() + "/velodyne_points/data/" + Numbered10(f, ".bin");
-  return SequenceDir() + "/velodyne/" + Numbered(f, ".bin");
+    return SequenceDir() + "/velodyne_points/data/" + ZeroPaddedName(f, 10, ".bin");
+  return SequenceDir() + "/velodyne/" + ZeroPaddedName(f, 6, ".bin");
 }
 std::string SequenceLayout::ImagePath(int64_t f) const {
   if (layout == SimLayout::kOxford)
     return SequenceDir() + "/stereo/centre/" + std::to_string(OxfordTime(f)) + ".png";
   if (layout == SimLayout::kKitti360) {
-    return root + "/data_2d_raw/" + Drive() + "/image_00/data_rect/" + Numbered10(f, ".png");
+    return root + "/data_2d_raw/" + Drive() + "/image_00/data_rect/" +
+           ZeroPaddedName(f, 10, ".png");
   }
-  return SequenceDir() + "/image_0/" + Numbered(f, ".png");
+  return SequenceDir() + "/image_0/" + ZeroPaddedName(f, 6, ".png");
 }
 std::string SequenceLayout::PosesPath() const {
   if (layout == SimLayout::kOxford) return SequenceDir() + "/gps/ins.csv";
@@ -149,15 +139,16 @@ void WriteKitti360Metadata(const SequenceLayout& layout, const Calibration& cali
   WriteTextFileAtomic(poses_dir + "/poses.txt", imu_poses);
 }
 
-// x y z roll pitch yaw of a rigid transform, R = Rz(yaw) Ry(pitch) Rx(roll).
-std::string FormatXyzRpy(const Rigid3d& t) {
-  const Eigen::Matrix3d r = t.RotationMatrix();
-  const double yaw = std::atan2(r(1, 0), r(0, 0));
-  const double pitch = std::atan2(-r(2, 0), std::hypot(r(0, 0), r(1, 0)));
-  const double roll = std::atan2(r(2, 1), r(2, 2));
+// x y z roll pitch yaw of a rigid transform (the SDK's convention, io/oxford.h), as text.
+std::vector<std::string> FormatXyzRpy(const Rigid3d& t) {
+  std::vector<std::string> out;
+  for (double v : OxfordXyzRpy(t)) out.push_back(FormatDouble(v, "%.17g"));
+  return out;
+}
+
+std::string JoinSpaced(const std::vector<std::string>& values) {
   std::string out;
-  for (double v : {t.translation().x(), t.translation().y(), t.translation().z(), roll, pitch, yaw})
-    out += (out.empty() ? "" : " ") + FormatDouble(v, "%.17g");
+  for (const auto& v : values) out += (out.empty() ? "" : " ") + v;
   return out;
 }
 
@@ -191,7 +182,7 @@ void WriteOxfordMetadata(const SequenceLayout& layout, const Calibration& calib,
   WriteTextFileAtomic(layout.root + "/models/stereo_narrow_left_distortion_lut.bin", lut);
   const Rigid3d vehicle_from_cam0(vehicle_from_optical, Eigen::Vector3d::Zero());
   WriteTextFileAtomic(layout.root + "/extrinsics/velodyne_left.txt",
-                      FormatXyzRpy(vehicle_from_cam0 * calib.cam0_from_velo) + "\n");
+                      JoinSpaced(FormatXyzRpy(vehicle_from_cam0 * calib.cam0_from_velo)) + "\n");
   WriteTextFileAtomic(layout.root + "/extrinsics/ins.txt", "0 0 0 0 0 0\n");
   WriteTextFileAtomic(layout.root + "/extrinsics/stereo.txt", "0 0 0 0 0 0\n");
   std::string stamps;
@@ -206,9 +197,7 @@ void WriteOxfordMetadata(const SequenceLayout& layout, const Calibration& calib,
     // frame 0 (level poses stay far from the Euler angles' singularity at pitch +-90 deg):
     // P_ins = vehicle_from_cam0 * world_from_cam0 * cam0_from_vehicle.
     const Rigid3d p = vehicle_from_cam0 * gt.world_from_cam[i] * cam0_from_vehicle;
-    std::string row = FormatXyzRpy(p);
-    std::vector<std::string> v;
-    for (auto tok : SplitWhitespace(row)) v.emplace_back(tok);
+    const std::vector<std::string> v = FormatXyzRpy(p);
     ins += std::to_string(t) + ",INS_SOLUTION_GOOD,0,0,0," + v[0] + "," + v[1] + "," + v[2] +
            ",30U,0,0,0," + v[3] + "," + v[4] + "," + v[5] + "\n";
   }
