@@ -15,7 +15,7 @@ void WriteLoopsArtifact(const std::string& path, const LoopsData& data,
   H5Writer writer(path, kLoopsSchema, kLoopsSchemaVersion);
   writer.WriteArray("keyframes", data.keyframes);
   std::vector<int64_t> query, match;
-  std::vector<int32_t> detector, status, correspondences;
+  std::vector<int32_t> detector, status, correspondences, inliers;
   std::vector<double> pose, score, ring, yaw, residual;
   for (const LoopRecord& r : data.loops) {
     query.push_back(r.query);
@@ -28,6 +28,7 @@ void WriteLoopsArtifact(const std::string& path, const LoopsData& data,
     ring.push_back(r.ring_key_distance);
     yaw.push_back(r.yaw_deg);
     correspondences.push_back(r.correspondences);
+    inliers.push_back(r.inliers);
     residual.push_back(r.residual);
   }
   writer.WriteArray("loops/query", query);
@@ -39,6 +40,7 @@ void WriteLoopsArtifact(const std::string& path, const LoopsData& data,
   writer.WriteArray("loops/ring_key_distance", ring);
   writer.WriteArray("loops/yaw_deg", yaw);
   writer.WriteArray("loops/correspondences", correspondences);
+  writer.WriteArray("loops/inliers", inliers);
   writer.WriteArray("loops/residual", residual);
   writer.Commit(provenance);
 }
@@ -60,11 +62,12 @@ LoopsData ReadLoopsArtifact(const std::string& path) {
   const auto ring = reader.ReadArray<double>("loops/ring_key_distance");
   const auto yaw = reader.ReadArray<double>("loops/yaw_deg");
   const auto correspondences = reader.ReadArray<int32_t>("loops/correspondences");
+  const auto inliers = reader.ReadArray<int32_t>("loops/inliers");
   const auto residual = reader.ReadArray<double>("loops/residual");
   const size_t m = query.size();
   JVL_CHECK(match.size() == m && detector.size() == m && status.size() == m &&
                 pose.size() == 7 * m && score.size() == m && ring.size() == m && yaw.size() == m &&
-                correspondences.size() == m && residual.size() == m,
+                correspondences.size() == m && inliers.size() == m && residual.size() == m,
             path << ": the loops/* datasets disagree in length (loops/query has " << m << " rows)");
   auto is_keyframe = [&](int64_t f) {
     return std::binary_search(data.keyframes.begin(), data.keyframes.end(), f);
@@ -83,6 +86,7 @@ LoopsData ReadLoopsArtifact(const std::string& path) {
     r.ring_key_distance = ring[i];
     r.yaw_deg = yaw[i];
     r.correspondences = correspondences[i];
+    r.inliers = inliers[i];
     r.residual = residual[i];
     data.loops.push_back(r);
   }
@@ -91,15 +95,15 @@ LoopsData ReadLoopsArtifact(const std::string& path) {
 
 std::string FormatLoopsCsv(const LoopsData& data) {
   std::ostringstream out;
-  out << "query,match,detector,status,score,ring_key_distance,yaw_deg,correspondences,residual,"
-         "tx,ty,tz\n";
+  out << "query,match,detector,status,score,ring_key_distance,yaw_deg,correspondences,inliers,"
+         "residual,tx,ty,tz\n";
   for (const LoopRecord& r : data.loops) {
     const Eigen::Vector3d& t = r.match_from_query.translation();
     out << r.query << ',' << r.match << ',' << r.detector << ',' << r.status << ','
         << FormatDouble(r.score) << ',' << FormatDouble(r.ring_key_distance) << ','
-        << FormatDouble(r.yaw_deg) << ',' << r.correspondences << ',' << FormatDouble(r.residual)
-        << ',' << FormatDouble(t.x()) << ',' << FormatDouble(t.y()) << ',' << FormatDouble(t.z())
-        << '\n';
+        << FormatDouble(r.yaw_deg) << ',' << r.correspondences << ',' << r.inliers << ','
+        << FormatDouble(r.residual) << ',' << FormatDouble(t.x()) << ',' << FormatDouble(t.y())
+        << ',' << FormatDouble(t.z()) << '\n';
   }
   return out.str();
 }

@@ -1,4 +1,4 @@
-// The "loops" artifact (schema loops v1, schemas/loops.schema.json) written by loop_detect: the
+// The "loops" artifact (schema loops v2, schemas/loops.schema.json) written by loop_detect: the
 // keyframes searched and every verified loop candidate, accepted or not, with its relative pose,
 // scores and the detector that proposed it.
 #pragma once
@@ -13,7 +13,7 @@
 namespace jvl::io {
 
 constexpr char kLoopsSchema[] = "loops";
-constexpr int kLoopsSchemaVersion = 1;
+constexpr int kLoopsSchemaVersion = 2;
 
 // One verified candidate, as stored (plain values, independent of the loop library).
 struct LoopRecord {
@@ -22,10 +22,12 @@ struct LoopRecord {
   int32_t detector = 0;      // 0 = LiDAR descriptor, 1 = visual words.
   int32_t status = 0;        // 0 = accepted; > 0: why not (LoopStatus of libs/loop).
   Rigid3d match_from_query;  // cam0 frames.
-  double score = 0;          // Detector's distance (LiDAR: descriptor distance, 0 = identical).
+  // LiDAR: descriptor distance (0 = identical); visual: bag-of-words score (1 = identical).
+  double score = 0;
   double ring_key_distance = 0;
   double yaw_deg = 0;  // Detector's yaw estimate of the query relative to the match.
   int32_t correspondences = 0;
+  int32_t inliers = 0;  // Visual: PnP inliers (0 for the LiDAR detector).
   double residual = 0;  // m, RMS IMLS distance after registration.
 };
 
@@ -40,7 +42,8 @@ void WriteLoopsArtifact(const std::string& path, const LoopsData& data,
 LoopsData ReadLoopsArtifact(const std::string& path);
 
 // CSV: header "query,match,detector,status,score,ring_key_distance,yaw_deg,correspondences,
-// residual,tx,ty,tz" (tx, ty, tz: translation of match_from_query), shortest round-trip numbers.
+// inliers,residual,tx,ty,tz" (tx, ty, tz: translation of match_from_query), shortest round-trip
+// numbers.
 std::string FormatLoopsCsv(const LoopsData& data);
 void WriteLoopsCsv(const std::string& path, const LoopsData& data);
 

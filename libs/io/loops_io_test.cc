@@ -29,6 +29,8 @@ LoopsData Sample() {
   a.correspondences = 880;
   a.residual = 0.031;
   LoopRecord b = a;
+  b.detector = 1;
+  b.inliers = 143;
   b.query = 605;
   b.match = 10;
   b.status = 4;
@@ -49,13 +51,15 @@ TEST(LoopsIo, RoundTripSchemaAndCsv) {
   EXPECT_EQ(out.loops[0].match_from_query.ToArray(), in.loops[0].match_from_query.ToArray());
   EXPECT_EQ(out.loops[0].yaw_deg, 174);
   EXPECT_EQ(out.loops[0].correspondences, 880);
+  EXPECT_EQ(out.loops[1].detector, 1);
+  EXPECT_EQ(out.loops[1].inliers, 143);
   EXPECT_TRUE(CheckH5AgainstSchema(path, std::string(JVL_SOURCE_DIR) + "/schemas/loops.schema.json")
                   .empty());
   const std::string csv = FormatLoopsCsv(out);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
-            "query,match,detector,status,score,ring_key_distance,yaw_deg,correspondences,residual,"
-            "tx,ty,tz");
-  EXPECT_NE(csv.find("\n605,10,0,4,0.21,"), std::string::npos);
+            "query,match,detector,status,score,ring_key_distance,yaw_deg,correspondences,inliers,"
+            "residual,tx,ty,tz");
+  EXPECT_NE(csv.find("\n605,10,1,4,0.21,0.13,174,880,143,0.031,"), std::string::npos);
   std::filesystem::remove(path);
 }
 

@@ -50,16 +50,19 @@ const char* ToString(LoopStatus status) {
       return "inconsistent";
     case LoopStatus::kFarInPrior:
       return "far in the prior";
+    case LoopStatus::kFewInliers:
+      return "few inliers";
+    case LoopStatus::kDisagree:
+      return "registration disagrees";
+    case LoopStatus::kDuplicate:
+      return "duplicate";
   }
   return "unknown";
 }
 
-namespace {
-
-// Registers `query` on the model of `match` (both cam0 frames) from `initial` = match_from_query:
-// a coarse pass with scaled neighbourhoods, then the normal one (as lidar_odom's first pair).
-lidar::RegistrationResult Verify(const lidar::ScanSurface& query, const lidar::ScanSurface& match,
-                                 const Rigid3d& initial, const LidarLoopOptions& o) {
+lidar::RegistrationResult RegisterLoopScans(const lidar::ScanSurface& query,
+                                            const lidar::ScanSurface& match, const Rigid3d& initial,
+                                            const LidarLoopOptions& o) {
   auto run = [&](const lidar::AssociationOptions& association,
                  const lidar::RegistrationOptions& registration, const Rigid3d& start) {
     lidar::ImlsModel model(association.search_radius);
@@ -77,24 +80,41 @@ lidar::RegistrationResult Verify(const lidar::ScanSurface& query, const lidar::S
   return run(o.association, o.registration, start);
 }
 
-}  // namespace
+lidar::ScanSurface LoopSurface(const PointCloud& scan, const Calibration& calibration,
+                               const LidarLoopOptions& o) {
+  const lidar::PreprocessedScan pre =
+      lidar::PreprocessScan(scan, calibration.cam0_from_velo, o.preprocess, 1);
+  return lidar::ComputeSurface(pre.points, o.surface, 1);
+}
 
-LidarLoopResult DetectLidarLoops(const Trajectory& keyframes,
-                                 const std::function<PointCloud(int64_t)>& load_scan,
-                                 const Calibration& calibration, const LidarLoopOptions& o,
-                                 int threads, const std::function<void()>& tick) {
-  o.Check();
-  keyframes.Check("loop keyframes");
-  const size_t n = keyframes.size();
-  LidarLoopResult result;
-  result.keyframes = keyframes.frames;
-  // Path length along the trajectory at every keyframe.
-  std::vector<double> path(n, 0.0);
-  for (size_t i = 1; i < n; ++i) {
+LoopStatus RegistrationStatus(const lidar::RegistrationResult& reg, const LidarLoopOptions& o) {
+  if (!reg.ok || !reg.converged || reg.degenerate) return LoopStatus::kRegistrationFailed;
+  if (reg.residual > o.max_residual || reg.correspondences < o.min_correspondences)
+    return LoopStatus::kResidual;
+  if (reg.world_from_scan.translation().norm() > o.max_translation) return LoopStatus::kTooFar;
+  return LoopStatus::kAccepted;
+}
+
+std::vector<double> PathLengths(const Trajectory& keyframes) {
+  std::vector<double> path(keyframes.size(), 0.0);
+  for (size_t i = 1; i < keyframes.size(); ++i) {
     path[i] = path[i - 1] + (keyframes.world_from_cam[i].translation() -
                              keyframes.world_from_cam[i - 1].translation())
                                 .norm();
   }
+  return path;
+}
+
+LoopResult DetectLidarLoops(const Trajectory& keyframes,
+                            const std::function<PointCloud(int64_t)>& load_scan,
+                            const Calibration& calibration, const LidarLoopOptions& o, int threads,
+                            const std::function<void()>& tick) {
+  o.Check();
+  keyframes.Check("loop keyframes");
+  const size_t n = keyframes.size();
+  LoopResult result;
+  result.keyframes = keyframes.frames;
+  const std::vector<double> path = PathLengths(keyframes);
   std::vector<ScanDescriptor> descriptors(n);
   ParallelFor(static_cast<int64_t>(n), threads, [&](int64_t i) {
     descriptors[i] = ComputeScanDescriptor(load_scan(keyframes.frames[i]).points, o.descriptor);
@@ -147,11 +167,7 @@ LidarLoopResult DetectLidarLoops(const Trajectory& keyframes,
   std::vector<LoopCandidate> verified(to_verify.size());
   std::vector<size_t> chosen(to_verify.size());  // Keyframe index of each verified match.
   const Rigid3d& cam0_from_velo = calibration.cam0_from_velo;
-  auto surface_of = [&](int64_t frame) {
-    const lidar::PreprocessedScan pre =
-        lidar::PreprocessScan(load_scan(frame), cam0_from_velo, o.preprocess, 1);
-    return lidar::ComputeSurface(pre.points, o.surface, 1);
-  };
+  auto surface_of = [&](int64_t frame) { return LoopSurface(load_scan(frame), calibration, o); };
   // Query points = Rz(yaw) match points (velodyne frames): velo_match_from_velo_query is
   // Rz(-yaw).
   auto initial_for = [&](double yaw) {
@@ -160,13 +176,7 @@ LidarLoopResult DetectLidarLoops(const Trajectory& keyframes,
         Eigen::Vector3d::Zero());
     return cam0_from_velo * velo_match_from_query * cam0_from_velo.Inverse();
   };
-  auto status_of = [&](const lidar::RegistrationResult& reg) {
-    if (!reg.ok || !reg.converged || reg.degenerate) return LoopStatus::kRegistrationFailed;
-    if (reg.residual > o.max_residual || reg.correspondences < o.min_correspondences)
-      return LoopStatus::kResidual;
-    if (reg.world_from_scan.translation().norm() > o.max_translation) return LoopStatus::kTooFar;
-    return LoopStatus::kAccepted;
-  };
+  auto status_of = [&](const lidar::RegistrationResult& reg) { return RegistrationStatus(reg, o); };
   // One candidate, registered from its best yaw and from the opposite one.
   auto VerifyPick = [&](const Pick& pick, size_t q, const lidar::ScanSurface& query_surface) {
     LoopCandidate c;
@@ -176,12 +186,13 @@ LidarLoopResult DetectLidarLoops(const Trajectory& keyframes,
     c.descriptor_distance = pick.m.distance;
     const lidar::ScanSurface match_surface = surface_of(c.match);
     double yaw = pick.m.yaw;
-    lidar::RegistrationResult reg = Verify(query_surface, match_surface, initial_for(yaw), o);
+    lidar::RegistrationResult reg =
+        RegisterLoopScans(query_surface, match_surface, initial_for(yaw), o);
     LoopStatus status = status_of(reg);
     // Both ways round: a street seen from the other direction matches itself turned by 180 deg
     // and shifted across the road nearly as well; the lower residual decides.
     const lidar::RegistrationResult other =
-        Verify(query_surface, match_surface, initial_for(pick.opposite.yaw), o);
+        RegisterLoopScans(query_surface, match_surface, initial_for(pick.opposite.yaw), o);
     const LoopStatus other_status = status_of(other);
     if (other_status == status ? other.residual < reg.residual
                                : other_status == LoopStatus::kAccepted) {

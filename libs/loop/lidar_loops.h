@@ -64,6 +64,9 @@ enum class LoopStatus : int32_t {
   kTooFar = 3,              // Registered more than max_translation apart.
   kInconsistent = 4,        // Verified, but the keyframes before it do not agree.
   kFarInPrior = 5,          // The trajectory puts the two keyframes too far apart.
+  kFewInliers = 6,          // Visual: too few 3D-2D matches agree on one relative pose.
+  kDisagree = 7,            // Visual: the scan registration moved far from the image's pose.
+  kDuplicate = 8,           // Accepted, but the LiDAR detector closed the same query already.
 };
 const char* ToString(LoopStatus status);
 
@@ -73,17 +76,19 @@ struct LoopCandidate {
   int64_t match = 0;
   std::string detector = "lidar";
   double ring_key_distance = 0;
+  // LiDAR: descriptor distance (0 = identical); visual: bag-of-words score (1 = identical).
   double descriptor_distance = 0;
   double yaw_rad = 0;        // The descriptor's yaw of the query relative to the match.
   Rigid3d match_from_query;  // cam0 frames; from the registration.
   int correspondences = 0;
+  int inliers = 0;      // Visual: 3D-2D matches consistent with the image's relative pose.
   double residual = 0;  // m.
   bool converged = false;
   bool degenerate = false;
   LoopStatus status = LoopStatus::kRegistrationFailed;
 };
 
-struct LidarLoopResult {
+struct LoopResult {
   std::vector<int64_t> keyframes;         // Frames searched, in order.
   std::vector<LoopCandidate> candidates;  // By query; status kAccepted = a loop.
 };
@@ -92,9 +97,24 @@ struct LidarLoopResult {
 // them is used). load_scan(frame): the scan as read (not de-skewed). calibration: cam0_from_velo
 // for the preprocessing (the descriptor is computed in the velodyne frame). tick() is called
 // once per keyframe described and once per candidate verified (progress).
-LidarLoopResult DetectLidarLoops(const Trajectory& keyframes,
-                                 const std::function<PointCloud(int64_t)>& load_scan,
-                                 const Calibration& calibration, const LidarLoopOptions& options,
-                                 int threads, const std::function<void()>& tick = nullptr);
+LoopResult DetectLidarLoops(const Trajectory& keyframes,
+                            const std::function<PointCloud(int64_t)>& load_scan,
+                            const Calibration& calibration, const LidarLoopOptions& options,
+                            int threads, const std::function<void()>& tick = nullptr);
+
+// The verification shared by both detectors. The scan of a keyframe preprocessed as lidar_odom
+// does it (cam0 frame) with its surface ...
+lidar::ScanSurface LoopSurface(const PointCloud& scan, const Calibration& calibration,
+                               const LidarLoopOptions& options);
+// ... `query` registered on the model of `match` from `initial` = match_from_query: a coarse pass
+// with scaled neighbourhoods, then the normal one (as lidar_odom's first pair) ...
+lidar::RegistrationResult RegisterLoopScans(const lidar::ScanSurface& query,
+                                            const lidar::ScanSurface& match, const Rigid3d& initial,
+                                            const LidarLoopOptions& options);
+// ... and its status against the bounds (accepted, registration failed, residual, too far).
+LoopStatus RegistrationStatus(const lidar::RegistrationResult& registration,
+                              const LidarLoopOptions& options);
+// Path length along the keyframes' trajectory at every keyframe.
+std::vector<double> PathLengths(const Trajectory& keyframes);
 
 }  // namespace jvl::loop

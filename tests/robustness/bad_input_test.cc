@@ -562,6 +562,14 @@ TEST_F(BadInputTest, InvalidOptions) {
   ExpectError("loop_detect", loops + " --max-descriptor-distance 0",
               "--max-descriptor-distance must be in (0, 1]");
   ExpectError("loop_detect", loops + " --consistency 0", "--consistency must be >= 1");
+  ExpectError("loop_detect", loops + " --visual-consistency 0",
+              "--visual-consistency must be >= 1");
+  ExpectError("loop_detect", loops + " --min-inliers 2", "--min-inliers must be >= 4");
+  ExpectError("loop_detect", loops + " --visual-features 0", "--visual-features must be > 0");
+  ExpectError("loop_detect", loops + " --detectors lidar,radar", "--detectors");
+  ExpectError("loop_detect", loops + " --vocabulary " + Bad("no_vocabulary.h5"),
+              "no_vocabulary.h5 not found: give one with --vocabulary");
+  ExpectError("loop_detect", loops + " --vocabulary " + In("odom.h5"), "odom.h5");
   ExpectError("loop_detect", "-d " + kSeq + " --poses " + Bad("none.h5") + " -o " + Bad("l.h5"),
               "none.h5");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --sequence 1x",

@@ -1,12 +1,17 @@
 // loop_detect: loop closures of a drive (the paper's loop-closing module, supplement 1.3).
-// Reads the dataset's scans and a trajectory (the prior or the odometry: only its path length is
-// used, to skip the keyframes just driven), finds revisited places with the LiDAR place
-// descriptor, verifies each candidate by registering the two scans, and writes every verified
-// candidate, accepted or not, to a loops artifact. With --gt it reports the revisits of the
-// ground truth and how many were found (recall) and how many loops were right (precision).
+// Reads the dataset's scans and images and a trajectory (the prior or the odometry: only its path
+// length is used, to skip the keyframes just driven, and a bound on its drift), finds revisited
+// places with two independent detectors - the LiDAR place descriptor and the paper's visual words
+// (bag of binary words, ORB-SLAM2's procedure) - verifies each candidate (scan registration;
+// visual: PnP on LiDAR depth, then scan registration), and writes every verified candidate,
+// accepted or not, to a loops artifact. With --gt it reports the revisits of the ground truth and
+// how many each detector found (recall) and how many loops were right (precision).
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +24,8 @@
 #include "io/loops_io.h"
 #include "io/trajectory_io.h"
 #include "loop/lidar_loops.h"
+#include "loop/visual_loops.h"
+#include "loop/vocabulary.h"
 
 namespace {
 
@@ -43,8 +50,10 @@ Trajectory SelectKeyframes(const Trajectory& poses, const io::Dataset& dataset, 
 // min_separation back along the true path lies within 5 m (same direction: headings within
 // 30 deg; opposite: more than 150 deg apart). A loop is right when its relative pose is within
 // 1 m and 2 deg of the true one.
+// detector: -1 = every accepted loop; 0 / 1 = the loops that detector accepted (a visual loop
+// marked duplicate counts for the visual detector).
 void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
-                              double min_separation) {
+                              double min_separation, int detector, const std::string& label) {
   Trajectory kf;
   for (const int64_t f : loops.keyframes) {
     const auto i = gt.IndexOf(f);
@@ -70,8 +79,11 @@ void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
   }
   std::vector<int> found(n, 0);
   int accepted = 0, right = 0;
+  constexpr int32_t kDuplicate = static_cast<int32_t>(loop::LoopStatus::kDuplicate);
   for (const io::LoopRecord& r : loops.loops) {
-    if (r.status != 0) continue;
+    if (detector < 0 ? r.status != 0
+                     : (r.detector != detector || (r.status != 0 && r.status != kDuplicate)))
+      continue;
     ++accepted;
     const auto q = gt.IndexOf(r.query), m = gt.IndexOf(r.match);
     const Rigid3d truth = gt.world_from_cam[*m].Inverse() * gt.world_from_cam[*q];
@@ -95,15 +107,28 @@ void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
     if (kind[q] == 1) same += 1, same_found += found[q];
     if (kind[q] == 2) opposite += 1, opposite_found += found[q];
   }
+  // Stretches: runs of consecutive revisiting keyframes of one kind; closed when a right loop
+  // has its query in the run.
+  int stretches[3] = {0, 0, 0}, closed[3] = {0, 0, 0};
+  for (size_t q = 0; q < n;) {
+    size_t end = q;
+    int any = 0;
+    while (end < n && kind[end] == kind[q]) any |= found[end++];
+    stretches[kind[q]] += 1;
+    closed[kind[q]] += any;
+    q = end;
+  }
   auto pct = [](int a, int b) {
     return b > 0 ? fmt::format("{:.0f} %", 100.0 * a / b) : std::string("-");
   };
   spdlog::info(
-      "against --gt: {} accepted loops, {} right (precision {}); revisiting keyframes "
+      "against --gt, {}: {} accepted loops, {} right (precision {}); revisiting keyframes "
       "{} in the same direction, {} found (recall {}), {} in the opposite direction, "
-      "{} found (recall {})",
-      accepted, right, pct(right, accepted), same, same_found, pct(same_found, same), opposite,
-      opposite_found, pct(opposite_found, opposite));
+      "{} found (recall {}); revisit stretches closed: same direction {} of {} ({}), "
+      "opposite {} of {} ({})",
+      label, accepted, right, pct(right, accepted), same, same_found, pct(same_found, same),
+      opposite, opposite_found, pct(opposite_found, opposite), closed[1], stretches[1],
+      pct(closed[1], stretches[1]), closed[2], stretches[2], pct(closed[2], stretches[2]));
 }
 
 }  // namespace
@@ -111,12 +136,18 @@ void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
 int main(int argc, char** argv) {
   app::Tool tool("loop_detect",
                  "Loop closures of a drive: revisited places found with a LiDAR place descriptor "
-                 "(polar grid of largest heights, rotation-invariant ring key), each candidate "
-                 "verified by registering the two scans; every verified candidate, accepted or "
-                 "not, goes to the loops artifact.");
+                 "(polar grid of largest heights, rotation-invariant ring key) and with visual "
+                 "words (bag of binary ORB words, ORB-SLAM2's candidate groups and temporal "
+                 "consistency); a LiDAR candidate is verified by registering the two scans, a "
+                 "visual one by PnP on the LiDAR depth of the earlier image and then the scan "
+                 "registration; every verified candidate, accepted or not, goes to the loops "
+                 "artifact.");
   std::string dataset_dir, format = "auto", frames = ":", poses_path, output, gt_path, csv;
   int every = 5;
+  std::vector<std::string> detectors = {"lidar", "visual"};
+  std::string vocabulary_path = JVL_DEFAULT_VOCABULARY;
   loop::LidarLoopOptions options;
+  loop::VisualLoopOptions visual_options;
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
@@ -134,6 +165,16 @@ int main(int argc, char** argv) {
       cli.add_option("--csv", csv,
                      "Also write the candidates as CSV (query, match, detector, status, "
                      "scores, registration, relative translation)"));
+  cli.add_option("--detectors", detectors,
+                 "Detectors to run: lidar, visual or both (a visual loop whose query the LiDAR "
+                 "detector closed too is kept with status 8, duplicate)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"lidar", "visual"}))
+      ->capture_default_str();
+  cli.add_option("--vocabulary", vocabulary_path,
+                 "Vocabulary of the visual detector (vocab_train); the default is the one shipped "
+                 "in data/vocabulary")
+      ->capture_default_str();
   cli.add_option("--gt", gt_path,
                  "Ground-truth trajectory: report the revisits and the loops' recall and "
                  "precision in the log");
@@ -148,9 +189,34 @@ int main(int argc, char** argv) {
             "Accept a registration with at least this many correspondences");
   lidar.Add("--consistency", "consistency", options.consistency,
             "Accept a loop when this many consecutive keyframes have verified matches that agree");
+  app::OptionGroup visual(tool, "Visual detector");
+  visual.Add("--visual-consistency", "visual_consistency", visual_options.consistency,
+             "Verify a candidate group once this many consecutive keyframes have overlapping "
+             "groups");
+  visual.Add("--min-inliers", "min_inliers", visual_options.min_inliers,
+             "Accept a visual candidate with at least this many PnP inliers");
+  visual.Add("--visual-features", "num_features", visual_options.orb.num_features,
+             "ORB features per keyframe image");
 
   return tool.Run(argc, argv, [&] {
     options.Check();
+    const bool use_lidar =
+        std::find(detectors.begin(), detectors.end(), "lidar") != detectors.end();
+    const bool use_visual =
+        std::find(detectors.begin(), detectors.end(), "visual") != detectors.end();
+    // The visual detector shares the LiDAR detector's registration bounds and separation.
+    visual_options.lidar = options;
+    visual_options.min_separation_m = options.min_separation_m;
+    visual_options.Check();
+    std::optional<loop::Vocabulary> vocabulary;
+    if (use_visual) {
+      JVL_CHECK(std::filesystem::exists(vocabulary_path),
+                "vocabulary " << vocabulary_path
+                              << " not found: give one with --vocabulary (vocab_train makes one) "
+                                 "or run only the LiDAR detector with --detectors lidar");
+      tool.AddInput(vocabulary_path, /*same_dataset=*/false);  // Serves every sequence.
+      vocabulary = loop::Vocabulary::Load(vocabulary_path);
+    }
     const auto dataset =
         io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
@@ -159,24 +225,52 @@ int main(int argc, char** argv) {
     const Trajectory keyframes = SelectKeyframes(poses, *dataset, every);
     JVL_CHECK(keyframes.size() >= 2,
               poses_path << ": fewer than 2 of its frames are in the dataset");
-    Progress progress("keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
-    const loop::LidarLoopResult result = loop::DetectLidarLoops(
-        keyframes, [&](int64_t f) { return dataset->LoadScan(f); }, dataset->calibration(), options,
-        tool.threads(), [&] { progress.Tick(); });
+    auto load_scan = [&](int64_t f) { return dataset->LoadScan(f); };
+    std::vector<loop::LoopCandidate> candidates;
+    std::vector<int64_t> lidar_closed;  // Queries the LiDAR detector accepted.
+    if (use_lidar) {
+      Progress progress("LiDAR keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
+      const loop::LoopResult result =
+          loop::DetectLidarLoops(keyframes, load_scan, dataset->calibration(), options,
+                                 tool.threads(), [&] { progress.Tick(); });
+      for (const loop::LoopCandidate& c : result.candidates) {
+        candidates.push_back(c);
+        if (c.status == loop::LoopStatus::kAccepted) lidar_closed.push_back(c.query);
+      }
+    }
+    if (use_visual) {
+      Progress progress("visual keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
+      const loop::LoopResult result = loop::DetectVisualLoops(
+          keyframes, [&](int64_t f) { return dataset->LoadImage(f, 0); }, load_scan,
+          dataset->calibration(), *vocabulary, visual_options, tool.threads(),
+          [&] { progress.Tick(); });
+      for (loop::LoopCandidate c : result.candidates) {
+        if (c.status == loop::LoopStatus::kAccepted &&
+            std::find(lidar_closed.begin(), lidar_closed.end(), c.query) != lidar_closed.end())
+          c.status = loop::LoopStatus::kDuplicate;
+        candidates.push_back(c);
+      }
+    }
+    // By query, the LiDAR detector's candidate first.
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const loop::LoopCandidate& a, const loop::LoopCandidate& b) {
+                       return a.query < b.query;
+                     });
     io::LoopsData data;
-    data.keyframes = result.keyframes;
+    data.keyframes = keyframes.frames;
     int accepted = 0;
-    for (const loop::LoopCandidate& c : result.candidates) {
+    for (const loop::LoopCandidate& c : candidates) {
       io::LoopRecord r;
       r.query = c.query;
       r.match = c.match;
-      r.detector = 0;
+      r.detector = c.detector == "visual" ? 1 : 0;
       r.status = static_cast<int32_t>(c.status);
       r.match_from_query = c.match_from_query;
       r.score = c.descriptor_distance;
       r.ring_key_distance = c.ring_key_distance;
       r.yaw_deg = c.yaw_rad * kRadToDeg;
       r.correspondences = c.correspondences;
+      r.inliers = c.inliers;
       r.residual = c.residual;
       data.loops.push_back(r);
       accepted += c.status == loop::LoopStatus::kAccepted ? 1 : 0;
@@ -186,7 +280,11 @@ int main(int argc, char** argv) {
     spdlog::info("loop_detect: {} keyframes, {} candidates verified, {} loops accepted -> {}",
                  data.keyframes.size(), data.loops.size(), accepted, output);
     if (!gt_path.empty()) {
-      ReportAgainstGroundTruth(io::ReadTrajectory(gt_path), data, options.min_separation_m);
+      const Trajectory gt = io::ReadTrajectory(gt_path);
+      if (use_lidar) ReportAgainstGroundTruth(gt, data, options.min_separation_m, 0, "LiDAR");
+      if (use_visual) ReportAgainstGroundTruth(gt, data, options.min_separation_m, 1, "visual");
+      if (use_lidar && use_visual)
+        ReportAgainstGroundTruth(gt, data, options.min_separation_m, -1, "combined");
     }
   });
 }

@@ -1,0 +1,321 @@
+#include "loop/visual_loops.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+#include "core/check.h"
+#include "core/threads.h"
+
+namespace jvl::loop {
+
+void VisualLoopOptions::Check() const {
+  orb.Check();
+  lidar.Check();
+  JVL_CHECK(std::isfinite(min_separation_m) && min_separation_m >= 0,
+            "min_separation_m must be >= 0, got " << min_separation_m);
+  JVL_CHECK(group_keyframes >= 0, "group_keyframes must be >= 0, got " << group_keyframes);
+  JVL_CHECK(min_common_ratio > 0 && min_common_ratio <= 1,
+            "min_common_ratio must be in (0, 1], got " << min_common_ratio);
+  JVL_CHECK(min_group_ratio > 0 && min_group_ratio <= 1,
+            "min_group_ratio must be in (0, 1], got " << min_group_ratio);
+  JVL_CHECK(consistency >= 1, "visual_consistency must be >= 1, got " << consistency);
+  JVL_CHECK(match_level >= 0, "match_level must be >= 0, got " << match_level);
+  JVL_CHECK(max_hamming >= 0 && max_hamming <= 256,
+            "max_hamming must be in [0, 256], got " << max_hamming);
+  JVL_CHECK(ratio > 0 && ratio <= 1, "ratio must be in (0, 1], got " << ratio);
+  JVL_CHECK(depth_window_px >= 0 && max_depth_m > 0,
+            "depth_window_px must be >= 0 and max_depth_m > 0");
+  JVL_CHECK(max_reprojection_px > 0 && ransac_iterations >= 1,
+            "max_reprojection_px must be > 0 and ransac_iterations >= 1");
+  JVL_CHECK(min_inliers >= 4, "min_inliers must be >= 4, got " << min_inliers);
+  JVL_CHECK(max_disagreement_m > 0 && max_disagreement_deg > 0,
+            "max_disagreement_m and max_disagreement_deg must be > 0");
+}
+
+VisualKeyframe DescribeImage(const cv::Mat& image, const Vocabulary& vocabulary,
+                             const VisualLoopOptions& o) {
+  vision::OrbFeatures features = vision::ExtractOrb(image, o.orb);
+  VisualKeyframe k;
+  k.keypoints = std::move(features.keypoints);
+  k.descriptors = std::move(features.descriptors);
+  k.nodes.resize(k.descriptors.size());
+  for (size_t i = 0; i < k.descriptors.size(); ++i)
+    vocabulary.Word(k.descriptors[i], o.match_level, &k.nodes[i]);
+  k.bow = vocabulary.Transform(k.descriptors);
+  return k;
+}
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+// Matches of query features to match features within the same vocabulary node: the nearest by
+// Hamming distance up to max_hamming and below ratio x the second nearest; each match feature
+// keeps its best query feature. Pairs (query index, match index), by query index.
+std::vector<std::pair<int, int>> MatchByNode(const VisualKeyframe& q, const VisualKeyframe& m,
+                                             const VisualLoopOptions& o) {
+  std::map<int32_t, std::vector<int>> by_node;
+  for (size_t j = 0; j < m.nodes.size(); ++j) by_node[m.nodes[j]].push_back(static_cast<int>(j));
+  std::vector<int> best_query(m.descriptors.size(), -1), best_distance(m.descriptors.size(), 257);
+  for (size_t i = 0; i < q.descriptors.size(); ++i) {
+    const auto it = by_node.find(q.nodes[i]);
+    if (it == by_node.end()) continue;
+    int best = -1, d1 = 257, d2 = 257;
+    for (const int j : it->second) {
+      const int d =
+          vision::HammingDistance(q.descriptors[i], m.descriptors[static_cast<size_t>(j)]);
+      if (d < d1) {
+        d2 = d1, d1 = d, best = j;
+      } else if (d < d2) {
+        d2 = d;
+      }
+    }
+    if (best < 0 || d1 > o.max_hamming || (d2 <= 256 && d1 >= o.ratio * d2)) continue;
+    if (d1 < best_distance[static_cast<size_t>(best)]) {
+      best_distance[static_cast<size_t>(best)] = d1;
+      best_query[static_cast<size_t>(best)] = static_cast<int>(i);
+    }
+  }
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t j = 0; j < best_query.size(); ++j)
+    if (best_query[j] >= 0) pairs.emplace_back(best_query[j], static_cast<int>(j));
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+// Depth image of a scan in camera 0: the nearest return per pixel (0 where none).
+cv::Mat ScanDepth(const PointCloud& scan, const Calibration& calibration,
+                  const PinholeCamera& camera) {
+  cv::Mat depth(camera.height, camera.width, CV_32F, cv::Scalar(0));
+  for (const Eigen::Vector3d& p : scan.points) {
+    const Eigen::Vector3d c = calibration.cam0_from_velo * p;
+    if (c.z() < 0.5) continue;
+    const Eigen::Vector2d uv = camera.Project(c);
+    if (!camera.InImage(uv)) continue;
+    float& d = depth.at<float>(static_cast<int>(uv.y()), static_cast<int>(uv.x()));
+    if (d == 0 || c.z() < d) d = static_cast<float>(c.z());
+  }
+  return depth;
+}
+
+// Depth at a keypoint: the nearest return in the window, averaged with the returns within 5 %
+// of it; 0 unless at least two agree.
+double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoopOptions& o) {
+  const int r = static_cast<int>(std::ceil(o.depth_window_px));
+  const int u0 = static_cast<int>(uv.x()), v0 = static_cast<int>(uv.y());
+  std::vector<float> found;
+  for (int v = std::max(0, v0 - r); v <= std::min(depth.rows - 1, v0 + r); ++v)
+    for (int u = std::max(0, u0 - r); u <= std::min(depth.cols - 1, u0 + r); ++u)
+      if (const float d = depth.at<float>(v, u); d > 0) found.push_back(d);
+  if (found.size() < 2) return 0;
+  const float nearest = *std::min_element(found.begin(), found.end());
+  double sum = 0;
+  int count = 0;
+  for (const float d : found)
+    if (d <= nearest * 1.05f) sum += d, ++count;
+  const double z = sum / count;
+  return count >= 2 && z <= o.max_depth_m ? z : 0;
+}
+
+}  // namespace
+
+LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
+                                    const PointCloud& query_scan, const PointCloud& match_scan,
+                                    const Calibration& calibration, const VisualLoopOptions& o) {
+  LoopCandidate c;
+  c.detector = "visual";
+  c.status = LoopStatus::kFewInliers;
+  const PinholeCamera camera = calibration.Camera(0);
+  const cv::Mat depth = ScanDepth(match_scan, calibration, camera);
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (const auto& [qi, mi] : MatchByNode(query, match, o)) {
+    const Eigen::Vector2f& uv = match.keypoints[static_cast<size_t>(mi)].uv;
+    const double z = DepthAt(depth, uv, o);
+    if (z <= 0) continue;
+    const Eigen::Vector3d p = z * camera.Unproject(uv.cast<double>());
+    object.emplace_back(p.x(), p.y(), p.z());
+    const Eigen::Vector2f& q = query.keypoints[static_cast<size_t>(qi)].uv;
+    image.emplace_back(q.x(), q.y());
+  }
+  if (static_cast<int>(object.size()) < o.min_inliers) return c;
+  cv::Mat k;
+  cv::eigen2cv(camera.K(), k);
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  const bool solved =
+      cv::solvePnPRansac(object, image, k, cv::noArray(), rvec, tvec, false, o.ransac_iterations,
+                         static_cast<float>(o.max_reprojection_px), 0.999, inliers);
+  c.inliers = solved ? static_cast<int>(inliers.size()) : 0;
+  if (!solved || c.inliers < o.min_inliers) return c;
+  // solvePnP: x_query = R X_match + t, i.e. query_from_match.
+  cv::Mat r;
+  cv::Rodrigues(rvec, r);
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  cv::cv2eigen(r, rotation);
+  cv::cv2eigen(tvec, translation);
+  const Rigid3d image_pose =
+      Rigid3d(Eigen::Quaterniond(rotation).normalized(), translation).Inverse();
+
+  const lidar::ScanSurface query_surface = LoopSurface(query_scan, calibration, o.lidar);
+  const lidar::ScanSurface match_surface = LoopSurface(match_scan, calibration, o.lidar);
+  const lidar::RegistrationResult reg =
+      RegisterLoopScans(query_surface, match_surface, image_pose, o.lidar);
+  c.match_from_query = reg.ok ? reg.world_from_scan : image_pose;
+  c.correspondences = reg.correspondences;
+  c.residual = reg.residual;
+  c.converged = reg.converged;
+  c.degenerate = reg.degenerate;
+  c.status = RegistrationStatus(reg, o.lidar);
+  const Rigid3d moved = image_pose.Inverse() * c.match_from_query;
+  if (c.status == LoopStatus::kAccepted &&
+      (moved.translation().norm() > o.max_disagreement_m ||
+       RotationAngle(moved.rotation()) * kRadToDeg > o.max_disagreement_deg)) {
+    c.status = LoopStatus::kDisagree;
+  }
+  // Heading of the query relative to the match (about the camera's vertical, left positive).
+  const Eigen::Vector3d forward = c.match_from_query.rotation() * Eigen::Vector3d::UnitZ();
+  c.yaw_rad = std::atan2(-forward.x(), forward.z());
+  return c;
+}
+
+LoopResult DetectVisualLoops(const Trajectory& keyframes,
+                             const std::function<cv::Mat(int64_t)>& load_image,
+                             const std::function<PointCloud(int64_t)>& load_scan,
+                             const Calibration& calibration, const Vocabulary& vocabulary,
+                             const VisualLoopOptions& o, int threads,
+                             const std::function<void()>& tick) {
+  o.Check();
+  keyframes.Check("loop keyframes");
+  const size_t n = keyframes.size();
+  LoopResult result;
+  result.keyframes = keyframes.frames;
+  const std::vector<double> path = PathLengths(keyframes);
+  std::vector<VisualKeyframe> described(n);
+  ParallelFor(static_cast<int64_t>(n), threads, [&](int64_t i) {
+    described[static_cast<size_t>(i)] =
+        DescribeImage(load_image(keyframes.frames[static_cast<size_t>(i)]), vocabulary, o);
+    if (tick) tick();
+  });
+
+  // Inverted index: word -> keyframes holding it, filled as the queries advance (a query sees
+  // only the keyframes before it).
+  std::vector<std::vector<size_t>> inverted(static_cast<size_t>(vocabulary.num_words()));
+  struct Group {
+    long lo, hi;      // Keyframe indices.
+    int consecutive;  // Query keyframes in a row that had an overlapping group, this one included.
+  };
+  std::vector<Group> previous_groups;
+  std::vector<std::pair<size_t, size_t>> to_verify;  // (query, match) keyframe indices.
+  std::vector<double> to_verify_score;
+  const long nb = o.group_keyframes;
+  for (size_t q = 0; q < n; ++q) {
+    const BowVector& bow = described[q].bow;
+    // The lowest score against the query's own neighbours (the keyframes just before it).
+    double min_score = 1;
+    bool have_neighbour = false;
+    for (long b = 1; b <= std::max(nb, 1L) && static_cast<long>(q) - b >= 0; ++b) {
+      min_score =
+          std::min(min_score, Vocabulary::Score(bow, described[q - static_cast<size_t>(b)].bow));
+      have_neighbour = true;
+    }
+    if (!have_neighbour) min_score = 0;
+    // Earlier keyframes far enough back that share words with the query.
+    std::vector<int> common(q, 0);
+    for (const auto& [word, weight] : bow)
+      for (const size_t j : inverted[static_cast<size_t>(word)]) ++common[j];
+    int most = 0;
+    for (size_t j = 0; j < q; ++j)
+      if (path[q] - path[j] >= o.min_separation_m) most = std::max(most, common[j]);
+    std::vector<double> score(q, -1);  // >= 0: a candidate.
+    if (most > 0) {
+      const double least = o.min_common_ratio * most;
+      for (size_t j = 0; j < q; ++j) {
+        if (path[q] - path[j] < o.min_separation_m || common[j] < least) continue;
+        const double s = Vocabulary::Score(bow, described[j].bow);
+        if (s >= min_score) score[j] = s;
+      }
+    }
+    // Groups: a candidate with its candidate neighbours; the accumulated score, its best member.
+    std::vector<std::pair<double, size_t>> groups;  // (accumulated, best member)
+    double best_accumulated = 0;
+    for (size_t j = 0; j < q; ++j) {
+      if (score[j] < 0) continue;
+      double accumulated = 0, best = -1;
+      size_t best_member = j;
+      for (long g = static_cast<long>(j) - nb; g <= static_cast<long>(j) + nb; ++g) {
+        if (g < 0 || g >= static_cast<long>(q) || score[static_cast<size_t>(g)] < 0) continue;
+        accumulated += score[static_cast<size_t>(g)];
+        if (score[static_cast<size_t>(g)] > best)
+          best = score[static_cast<size_t>(g)], best_member = static_cast<size_t>(g);
+      }
+      groups.emplace_back(accumulated, best_member);
+      best_accumulated = std::max(best_accumulated, accumulated);
+    }
+    std::vector<size_t> representatives;
+    for (const auto& [accumulated, member] : groups)
+      if (accumulated >= o.min_group_ratio * best_accumulated) representatives.push_back(member);
+    std::sort(representatives.begin(), representatives.end());
+    representatives.erase(std::unique(representatives.begin(), representatives.end()),
+                          representatives.end());
+    // Temporal consistency with the previous query's groups.
+    std::vector<Group> current;
+    for (const size_t r : representatives) {
+      Group group{static_cast<long>(r) - nb, static_cast<long>(r) + nb, 1};
+      for (const Group& p : previous_groups)
+        if (group.lo <= p.hi && p.lo <= group.hi)
+          group.consecutive = std::max(group.consecutive, p.consecutive + 1);
+      current.push_back(group);
+      if (group.consecutive >= o.consistency) {
+        to_verify.emplace_back(q, r);
+        to_verify_score.push_back(score[r]);
+      }
+    }
+    previous_groups = std::move(current);
+    for (const auto& [word, weight] : bow) inverted[static_cast<size_t>(word)].push_back(q);
+  }
+
+  // Verification (independent, in parallel; results in their slots), then the best accepted
+  // candidate per query (most inliers), or the first rejected one.
+  std::vector<LoopCandidate> verified(to_verify.size());
+  ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t v) {
+    const auto [q, m] = to_verify[static_cast<size_t>(v)];
+    LoopCandidate c =
+        VerifyVisualCandidate(described[q], described[m], load_scan(keyframes.frames[q]),
+                              load_scan(keyframes.frames[m]), calibration, o);
+    c.query = keyframes.frames[q];
+    c.match = keyframes.frames[m];
+    c.descriptor_distance = to_verify_score[static_cast<size_t>(v)];
+    const double apart =
+        (keyframes.world_from_cam[q].translation() - keyframes.world_from_cam[m].translation())
+            .norm();
+    if (c.status == LoopStatus::kAccepted &&
+        apart > o.lidar.max_prior_offset + o.lidar.max_prior_drift * (path[q] - path[m])) {
+      c.status = LoopStatus::kFarInPrior;
+    }
+    verified[static_cast<size_t>(v)] = c;
+    if (tick) tick();
+  });
+  for (size_t v = 0; v < verified.size();) {
+    size_t end = v;
+    size_t keep = v;
+    while (end < verified.size() && verified[end].query == verified[v].query) {
+      const LoopCandidate& c = verified[end];
+      const LoopCandidate& k = verified[keep];
+      if (c.status == LoopStatus::kAccepted &&
+          (k.status != LoopStatus::kAccepted || c.inliers > k.inliers))
+        keep = end;
+      ++end;
+    }
+    result.candidates.push_back(verified[keep]);
+    v = end;
+  }
+  return result;
+}
+
+}  // namespace jvl::loop
