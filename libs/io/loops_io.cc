@@ -41,6 +41,25 @@ void WriteLoopsArtifact(const std::string& path, const LoopsData& data,
   writer.WriteArray("loops/yaw_deg", yaw);
   writer.WriteArray("loops/correspondences", correspondences);
   writer.WriteArray("loops/inliers", inliers);
+  // The 3D-2D matches of every loop, by loop row.
+  std::vector<int64_t> point_loop;
+  std::vector<double> p_match, match_uv, query_uv;
+  std::vector<int32_t> octaves;
+  for (size_t i = 0; i < data.loops.size(); ++i) {
+    for (const LoopPointRecord& p : data.loops[i].points) {
+      point_loop.push_back(static_cast<int64_t>(i));
+      p_match.insert(p_match.end(), {p.p_match.x(), p.p_match.y(), p.p_match.z()});
+      match_uv.insert(match_uv.end(), {p.match_uv.x(), p.match_uv.y()});
+      query_uv.insert(query_uv.end(), {p.query_uv.x(), p.query_uv.y()});
+      octaves.insert(octaves.end(), {p.match_octave, p.query_octave});
+    }
+  }
+  const int64_t np = static_cast<int64_t>(point_loop.size());
+  writer.WriteArray("loop_points/loop", point_loop);
+  writer.WriteArray("loop_points/p_match", p_match, {np, 3});
+  writer.WriteArray("loop_points/match_uv", match_uv, {np, 2});
+  writer.WriteArray("loop_points/query_uv", query_uv, {np, 2});
+  writer.WriteArray("loop_points/octaves", octaves, {np, 2});
   writer.WriteArray("loops/residual", residual);
   writer.Commit(provenance);
 }
@@ -89,6 +108,31 @@ LoopsData ReadLoopsArtifact(const std::string& path) {
     r.inliers = inliers[i];
     r.residual = residual[i];
     data.loops.push_back(r);
+  }
+  const auto point_loop = reader.ReadArray<int64_t>("loop_points/loop");
+  const auto p_match = reader.ReadArray<double>("loop_points/p_match", 3);
+  const auto match_uv = reader.ReadArray<double>("loop_points/match_uv", 2);
+  const auto query_uv = reader.ReadArray<double>("loop_points/query_uv", 2);
+  const auto octaves = reader.ReadArray<int32_t>("loop_points/octaves", 2);
+  const size_t np = point_loop.size();
+  JVL_CHECK(p_match.size() == 3 * np && match_uv.size() == 2 * np && query_uv.size() == 2 * np &&
+                octaves.size() == 2 * np,
+            path << ": the loop_points/* datasets disagree in length (loop_points/loop has " << np
+                 << " rows)");
+  for (size_t i = 0; i < np; ++i) {
+    JVL_CHECK(point_loop[i] >= 0 && static_cast<size_t>(point_loop[i]) < m,
+              path << ": loop_points row " << i << " refers to loop row " << point_loop[i] << " of "
+                   << m);
+    LoopPointRecord p;
+    p.p_match = Eigen::Vector3d(p_match[3 * i], p_match[3 * i + 1], p_match[3 * i + 2]);
+    p.match_uv = Eigen::Vector2d(match_uv[2 * i], match_uv[2 * i + 1]);
+    p.query_uv = Eigen::Vector2d(query_uv[2 * i], query_uv[2 * i + 1]);
+    p.match_octave = octaves[2 * i];
+    p.query_octave = octaves[2 * i + 1];
+    JVL_CHECK(p.p_match.allFinite() && p.p_match.z() > 0 && p.match_uv.allFinite() &&
+                  p.query_uv.allFinite(),
+              path << ": loop_points row " << i << " is not a point in front of the camera");
+    data.loops[static_cast<size_t>(point_loop[i])].points.push_back(p);
   }
   return data;
 }

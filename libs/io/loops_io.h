@@ -15,6 +15,14 @@ namespace jvl::io {
 constexpr char kLoopsSchema[] = "loops";
 constexpr int kLoopsSchemaVersion = 2;
 
+// A visual loop's 3D-2D match (PnP inlier): a point of the match keyframe (cam0 frame) and where
+// the match and the query images see it.
+struct LoopPointRecord {
+  Eigen::Vector3d p_match = Eigen::Vector3d::Zero();
+  Eigen::Vector2d match_uv = Eigen::Vector2d::Zero(), query_uv = Eigen::Vector2d::Zero();
+  int32_t match_octave = 0, query_octave = 0;
+};
+
 // One verified candidate, as stored (plain values, independent of the loop library).
 struct LoopRecord {
   int64_t query = 0;         // The later keyframe (dataset frame) ...
@@ -27,7 +35,9 @@ struct LoopRecord {
   double ring_key_distance = 0;
   double yaw_deg = 0;  // Detector's yaw estimate of the query relative to the match.
   int32_t correspondences = 0;
-  int32_t inliers = 0;  // Visual: PnP inliers (0 for the LiDAR detector).
+  int32_t inliers = 0;  // Visual: PnP inliers (0 for the LiDAR detector) ...
+  // ... stored for the accepted loops (status 0 and 8; empty otherwise and for LiDAR loops).
+  std::vector<LoopPointRecord> points;
   double residual = 0;  // m, RMS IMLS distance after registration.
 };
 

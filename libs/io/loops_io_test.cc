@@ -31,6 +31,8 @@ LoopsData Sample() {
   LoopRecord b = a;
   b.detector = 1;
   b.inliers = 143;
+  b.points.push_back({Eigen::Vector3d(1, -0.5, 12), Eigen::Vector2d(300.5, 120.25),
+                      Eigen::Vector2d(310, 118), 0, 2});
   b.query = 605;
   b.match = 10;
   b.status = 4;
@@ -53,6 +55,12 @@ TEST(LoopsIo, RoundTripSchemaAndCsv) {
   EXPECT_EQ(out.loops[0].correspondences, 880);
   EXPECT_EQ(out.loops[1].detector, 1);
   EXPECT_EQ(out.loops[1].inliers, 143);
+  EXPECT_TRUE(out.loops[0].points.empty());
+  ASSERT_EQ(out.loops[1].points.size(), 1u);
+  EXPECT_EQ(out.loops[1].points[0].p_match, Eigen::Vector3d(1, -0.5, 12));
+  EXPECT_EQ(out.loops[1].points[0].match_uv, Eigen::Vector2d(300.5, 120.25));
+  EXPECT_EQ(out.loops[1].points[0].query_uv, Eigen::Vector2d(310, 118));
+  EXPECT_EQ(out.loops[1].points[0].query_octave, 2);
   EXPECT_TRUE(CheckH5AgainstSchema(path, std::string(JVL_SOURCE_DIR) + "/schemas/loops.schema.json")
                   .empty());
   const std::string csv = FormatLoopsCsv(out);

@@ -105,6 +105,14 @@ std::vector<double> PathLengths(const Trajectory& keyframes) {
   return path;
 }
 
+bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, size_t q, size_t m,
+                const LidarLoopOptions& o) {
+  const double apart =
+      (keyframes.world_from_cam[q].translation() - keyframes.world_from_cam[m].translation())
+          .norm();
+  return apart > o.max_prior_offset + o.max_prior_drift * (path[q] - path[m]);
+}
+
 LoopResult DetectLidarLoops(const Trajectory& keyframes,
                             const std::function<PointCloud(int64_t)>& load_scan,
                             const Calibration& calibration, const LidarLoopOptions& o, int threads,
@@ -206,13 +214,8 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes,
     c.residual = reg.residual;
     c.converged = reg.converged;
     c.degenerate = reg.degenerate;
-    const double apart = (keyframes.world_from_cam[q].translation() -
-                          keyframes.world_from_cam[pick.match].translation())
-                             .norm();
-    if (status == LoopStatus::kAccepted &&
-        apart > o.max_prior_offset + o.max_prior_drift * (path[q] - path[pick.match])) {
+    if (status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, pick.match, o))
       status = LoopStatus::kFarInPrior;
-    }
     c.status = status;
     return c;
   };

@@ -70,6 +70,14 @@ enum class LoopStatus : int32_t {
 };
 const char* ToString(LoopStatus status);
 
+// A 3D-2D match of a visual loop (a PnP inlier): a point of the match keyframe (its cam0 frame,
+// depth from its scan) seen at match_uv in the match image and at query_uv in the query image.
+struct LoopPoint {
+  Eigen::Vector3d p_match = Eigen::Vector3d::Zero();
+  Eigen::Vector2d match_uv = Eigen::Vector2d::Zero(), query_uv = Eigen::Vector2d::Zero();
+  int match_octave = 0, query_octave = 0;  // ORB pyramid levels.
+};
+
 // A verified candidate (accepted or not): kept in the artifact for inspection.
 struct LoopCandidate {
   int64_t query = 0;  // Dataset frames: the later keyframe and its match.
@@ -81,8 +89,9 @@ struct LoopCandidate {
   double yaw_rad = 0;        // The descriptor's yaw of the query relative to the match.
   Rigid3d match_from_query;  // cam0 frames; from the registration.
   int correspondences = 0;
-  int inliers = 0;      // Visual: 3D-2D matches consistent with the image's relative pose.
-  double residual = 0;  // m.
+  int inliers = 0;  // Visual: 3D-2D matches consistent with the image's relative pose ...
+  std::vector<LoopPoint> points;  // ... (the inliers themselves).
+  double residual = 0;            // m.
   bool converged = false;
   bool degenerate = false;
   LoopStatus status = LoopStatus::kRegistrationFailed;
@@ -116,5 +125,9 @@ LoopStatus RegistrationStatus(const lidar::RegistrationResult& registration,
                               const LidarLoopOptions& options);
 // Path length along the keyframes' trajectory at every keyframe.
 std::vector<double> PathLengths(const Trajectory& keyframes);
+// The drift bound: keyframes q and m lie further apart in the trajectory than
+// max_prior_offset + max_prior_drift x the path length between them.
+bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, size_t q, size_t m,
+                const LidarLoopOptions& options);
 
 }  // namespace jvl::loop

@@ -133,14 +133,21 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
   const cv::Mat depth = ScanDepth(match_scan, calibration, camera);
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
+  std::vector<LoopPoint> points;
   for (const auto& [qi, mi] : MatchByNode(query, match, o)) {
-    const Eigen::Vector2f& uv = match.keypoints[static_cast<size_t>(mi)].uv;
-    const double z = DepthAt(depth, uv, o);
+    const vision::OrbKeypoint& km = match.keypoints[static_cast<size_t>(mi)];
+    const vision::OrbKeypoint& kq = query.keypoints[static_cast<size_t>(qi)];
+    const double z = DepthAt(depth, km.uv, o);
     if (z <= 0) continue;
-    const Eigen::Vector3d p = z * camera.Unproject(uv.cast<double>());
-    object.emplace_back(p.x(), p.y(), p.z());
-    const Eigen::Vector2f& q = query.keypoints[static_cast<size_t>(qi)].uv;
-    image.emplace_back(q.x(), q.y());
+    LoopPoint point;
+    point.p_match = z * camera.Unproject(km.uv.cast<double>());
+    point.match_uv = km.uv.cast<double>();
+    point.query_uv = kq.uv.cast<double>();
+    point.match_octave = km.octave;
+    point.query_octave = kq.octave;
+    object.emplace_back(point.p_match.x(), point.p_match.y(), point.p_match.z());
+    image.emplace_back(point.query_uv.x(), point.query_uv.y());
+    points.push_back(point);
   }
   if (static_cast<int>(object.size()) < o.min_inliers) return c;
   cv::Mat k;
@@ -152,6 +159,8 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
                          static_cast<float>(o.max_reprojection_px), 0.999, inliers);
   c.inliers = solved ? static_cast<int>(inliers.size()) : 0;
   if (!solved || c.inliers < o.min_inliers) return c;
+  std::sort(inliers.begin(), inliers.end());
+  for (const int i : inliers) c.points.push_back(points[static_cast<size_t>(i)]);
   // solvePnP: x_query = R X_match + t, i.e. query_from_match.
   cv::Mat r;
   cv::Rodrigues(rvec, r);
@@ -291,13 +300,8 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
     c.query = keyframes.frames[q];
     c.match = keyframes.frames[m];
     c.descriptor_distance = to_verify_score[static_cast<size_t>(v)];
-    const double apart =
-        (keyframes.world_from_cam[q].translation() - keyframes.world_from_cam[m].translation())
-            .norm();
-    if (c.status == LoopStatus::kAccepted &&
-        apart > o.lidar.max_prior_offset + o.lidar.max_prior_drift * (path[q] - path[m])) {
+    if (c.status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, m, o.lidar))
       c.status = LoopStatus::kFarInPrior;
-    }
     verified[static_cast<size_t>(v)] = c;
     if (tick) tick();
   });

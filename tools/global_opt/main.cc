@@ -149,7 +149,14 @@ int main(int argc, char** argv) {
           const auto& w = prior.world_from_cam;
           const Rigid3d rel =
               w[*pm2].Inverse() * w[*pm] * r.match_from_query * w[*pq].Inverse() * w[*pq2];
-          input.loops.push_back({static_cast<int64_t>(*q), static_cast<int64_t>(*m), rel});
+          mapping::LoopConstraint loop{static_cast<int64_t>(*q), static_cast<int64_t>(*m), rel, {}};
+          // The image points hold only where both ends are keyframes themselves.
+          if (input.keyframes.frames[*q] == r.query && input.keyframes.frames[*m] == r.match) {
+            for (const io::LoopPointRecord& p : r.points)
+              loop.points.push_back(
+                  {p.p_match, p.match_uv, p.query_uv, p.match_octave, p.query_octave});
+          }
+          input.loops.push_back(loop);
         }
         if (unplaced > 0) {
           spdlog::warn(

@@ -271,6 +271,10 @@ int main(int argc, char** argv) {
       r.yaw_deg = c.yaw_rad * kRadToDeg;
       r.correspondences = c.correspondences;
       r.inliers = c.inliers;
+      if (c.status == loop::LoopStatus::kAccepted || c.status == loop::LoopStatus::kDuplicate) {
+        for (const loop::LoopPoint& p : c.points)
+          r.points.push_back({p.p_match, p.match_uv, p.query_uv, p.match_octave, p.query_octave});
+      }
       r.residual = c.residual;
       data.loops.push_back(r);
       accepted += c.status == loop::LoopStatus::kAccepted ? 1 : 0;

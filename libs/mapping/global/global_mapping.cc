@@ -52,6 +52,21 @@ void GlobalMapInput::Check() const {
               "loop (" << l.match << ", " << l.query << ") out of range or not match < query");
 }
 
+int64_t AddLoopPoints(GlobalMapInput* input) {
+  int64_t added = 0;
+  for (const LoopConstraint& l : input->loops) {
+    const Rigid3d& world_from_match = input->keyframes.world_from_cam[static_cast<size_t>(l.match)];
+    for (const LoopConstraint::Point& p : l.points) {
+      const int32_t row = static_cast<int32_t>(input->map_points.size());
+      input->map_points.push_back(world_from_match * p.p_match);
+      input->observations.push_back({l.match, row, p.match_uv, p.match_octave});
+      input->observations.push_back({l.query, row, p.query_uv, p.query_octave});
+      added += 2;
+    }
+  }
+  return added;
+}
+
 double ApplyLoopCorrections(GlobalMapInput* input) {
   std::vector<LoopConstraint> loops = input->loops;
   std::stable_sort(
@@ -803,6 +818,12 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   }
   result.keyframes = input.keyframes;
   SelectVisualTerm(options, &input, &result);
+  if (options.use_loops && !input.loops.empty()) {
+    result.loop_visual = AddLoopPoints(&input);
+    if (result.loop_visual > 0)
+      spdlog::info("loops: {} visual observations of {} loop points", result.loop_visual,
+                   result.loop_visual / 2);
+  }
   const FixedTerms terms = PrepareFixedTerms(&input, options, &result);
   optim::JointProblemInput problem;
   problem.camera = input.camera;
@@ -959,8 +980,10 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
       {"traversal_time_s", r.traversal_time_s},
       {"total_time_s", r.total_time_s}};
   if (r.loops_used > 0) {
-    j["loops"] = {
-        {"used", r.loops_used}, {"imls", r.loop_imls}, {"correction_m", r.loop_correction_m}};
+    j["loops"] = {{"used", r.loops_used},
+                  {"imls", r.loop_imls},
+                  {"visual", r.loop_visual},
+                  {"correction_m", r.loop_correction_m}};
   }
   return j;
 }

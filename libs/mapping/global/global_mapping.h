@@ -34,6 +34,14 @@ struct LoopConstraint {
   int64_t query = 0;  // The later keyframe ...
   int64_t match = 0;  // ... and the earlier one it revisits (match < query).
   Rigid3d match_from_query;
+  // Visual loops: points of the match keyframe (its cam0 frame) seen in both images. Each enters
+  // the visual term as a map point observed by both keyframes.
+  struct Point {
+    Eigen::Vector3d p_match = Eigen::Vector3d::Zero();
+    Eigen::Vector2d match_uv = Eigen::Vector2d::Zero(), query_uv = Eigen::Vector2d::Zero();
+    int match_octave = 0, query_octave = 0;
+  };
+  std::vector<Point> points;
 };
 
 // Everything the global problem needs; keyframe references are rows of `keyframes`.
@@ -57,10 +65,16 @@ struct GlobalMapInput {
   Trajectory odometry;
   // Loops (GlobalMappingOptions::use_loops): the keyframes are corrected before the first round
   // (ApplyLoopCorrections), and every round adds point-to-IMLS correspondences of each loop's
-  // query scan against the scans around its match.
+  // query scan against the scans around its match; a visual loop's points join the visual term
+  // (AddLoopPoints).
   std::vector<LoopConstraint> loops;
   void Check() const;
 };
+
+// The points of the visual loops as map points (world = the match keyframe's current pose x
+// p_match) observed by both ends; after the visual term's selection, so that all of them stay.
+// Returns the observations added.
+int64_t AddLoopPoints(GlobalMapInput* input);
 
 // Algorithm 1 of the supplement for every loop, in the order of their query keyframes: the
 // query's pose becomes match x match_from_query, the keyframes between match and query get
@@ -181,7 +195,8 @@ struct GlobalMappingResult {
   optim::JointSolveResult solve;
   Trajectory keyframes;  // Optimised (same frames as the input keyframes).
   int64_t saved_imls = 0, fresh_imls = 0;
-  int64_t loops_used = 0, loop_imls = 0;  // Loops entered; their correspondences (last round).
+  int64_t loops_used = 0, loop_imls = 0;  // Loops entered; their correspondences (last round);
+  int64_t loop_visual = 0;                // their visual observations (two per loop point).
   double loop_correction_m = 0;           // Largest keyframe move by the loop correction.
   int64_t directions_used = 0, directions_not_keyframe = 0, directions_at_infinity = 0;
   // DirectionSource::kRefit: VPs dropped as outliers / in too small clusters, and the change of

@@ -398,7 +398,7 @@ TEST(GlobalMapping, LoopCorrectionMovesTheQueryOntoItsMeasuredPose) {
   in.observations.push_back(in.observations.back());
   in.observations.back().keyframe = 10;  // the first observer
   const Rigid3d rel = truth[2].Inverse() * truth[20];
-  in.loops.push_back({20, 2, rel});
+  in.loops.push_back({20, 2, rel, {}});
   const GlobalMapInput before = in;
   const double moved = ApplyLoopCorrections(&in);
   const auto& p = in.keyframes.world_from_cam;
@@ -423,6 +423,37 @@ TEST(GlobalMapping, LoopCorrectionMovesTheQueryOntoItsMeasuredPose) {
       1e-9);
 }
 
+// A visual loop's points become map points in the world (through the match keyframe's pose),
+// each observed by both ends with its pixel and pyramid level; loops without points add none.
+TEST(GlobalMapping, LoopPointsJoinTheVisualTermObservedByBothEnds) {
+  GlobalMapInput in;
+  for (int k = 0; k < 6; ++k)
+    in.keyframes.Append(5 * k, Rigid3d(ExpSO3(Eigen::Vector3d(0, 0.1 * k, 0)),
+                                       Eigen::Vector3d(0.5 * k, 0, 3.0 * k)));
+  in.map_points = {Eigen::Vector3d(0, 0, 10)};
+  LoopConstraint loop{5, 1, Rigid3d(), {}};
+  loop.points.push_back(
+      {Eigen::Vector3d(1, -2, 15), Eigen::Vector2d(400, 120), Eigen::Vector2d(380, 125), 1, 3});
+  loop.points.push_back(
+      {Eigen::Vector3d(-3, 0.5, 9), Eigen::Vector2d(200, 220), Eigen::Vector2d(190, 210), 0, 0});
+  in.loops = {loop, LoopConstraint{4, 0, Rigid3d(), {}}};
+  EXPECT_EQ(AddLoopPoints(&in), 4);
+  ASSERT_EQ(in.map_points.size(), 3u);
+  ASSERT_EQ(in.observations.size(), 4u);
+  const Rigid3d& world_from_match = in.keyframes.world_from_cam[1];
+  EXPECT_LT((in.map_points[1] - world_from_match * Eigen::Vector3d(1, -2, 15)).norm(), 1e-12);
+  EXPECT_LT((in.map_points[2] - world_from_match * Eigen::Vector3d(-3, 0.5, 9)).norm(), 1e-12);
+  EXPECT_EQ(in.observations[0].keyframe, 1);
+  EXPECT_EQ(in.observations[0].map_point, 1);
+  EXPECT_EQ(in.observations[0].uv, Eigen::Vector2d(400, 120));
+  EXPECT_EQ(in.observations[0].octave, 1);
+  EXPECT_EQ(in.observations[1].keyframe, 5);
+  EXPECT_EQ(in.observations[1].map_point, 1);
+  EXPECT_EQ(in.observations[1].uv, Eigen::Vector2d(380, 125));
+  EXPECT_EQ(in.observations[1].octave, 3);
+  EXPECT_EQ(in.observations[3].map_point, 2);
+}
+
 // The loop term: the query's scan meets the scans around its match, and the loop is reported.
 TEST(GlobalMapping, LoopsAddCorrespondencesBetweenTheirTwoEnds) {
   SyntheticGlobalOptions so;
@@ -431,7 +462,7 @@ TEST(GlobalMapping, LoopsAddCorrespondencesBetweenTheirTwoEnds) {
   auto synthetic = MakeSyntheticGlobal(so);
   // A revisit-like pair within scan range: keyframe 23 and keyframe 16, 14 m apart.
   synthetic.input.loops.push_back(
-      {23, 16, synthetic.truth_keyframes[16].Inverse() * synthetic.truth_keyframes[23]});
+      {23, 16, synthetic.truth_keyframes[16].Inverse() * synthetic.truth_keyframes[23], {}});
   GlobalMappingOptions o = Quiet();
   o.use_directions = false;
   const GlobalMappingResult with = OptimizeGlobal(synthetic.input, o);
