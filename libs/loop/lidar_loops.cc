@@ -32,6 +32,8 @@ void LidarLoopOptions::Check() const {
             "max_prior_offset must be > 0 and max_prior_drift >= 0, got "
                 << max_prior_offset << " and " << max_prior_drift);
   JVL_CHECK(consistency >= 1, "consistency must be >= 1, got " << consistency);
+  JVL_CHECK(consistency_yaw_deg > 0 && consistency_yaw_deg <= 180,
+            "consistency_yaw_deg must be in (0, 180], got " << consistency_yaw_deg);
   JVL_CHECK(consistency_keyframes >= 0,
             "consistency_keyframes must be >= 0, got " << consistency_keyframes);
 }
@@ -93,6 +95,11 @@ LoopStatus RegistrationStatus(const lidar::RegistrationResult& reg, const LidarL
     return LoopStatus::kResidual;
   if (reg.world_from_scan.translation().norm() > o.max_translation) return LoopStatus::kTooFar;
   return LoopStatus::kAccepted;
+}
+
+double RelativeHeading(const Rigid3d& match_from_query) {
+  const Eigen::Vector3d forward = match_from_query.rotation() * Eigen::Vector3d::UnitZ();
+  return std::atan2(-forward.x(), forward.z());
 }
 
 std::vector<double> PathLengths(const Trajectory& keyframes) {
@@ -240,11 +247,16 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes,
 
   // Temporal consistency: a verified match is accepted when the consistency - 1 keyframes
   // before its query have verified matches too, each within consistency_keyframes keyframes of
-  // the next one's.
+  // the next one's and turned the same way (registered headings within consistency_yaw_deg: a
+  // street end registered the wrong way round among right ones is not a loop).
   std::vector<std::optional<size_t>> match_of(n);  // Keyframe index of a verified match.
+  std::vector<double> heading_of(n, 0.0);          // Its registered relative heading.
   for (size_t v = 0; v < verified.size(); ++v) {
-    if (verified[v].status == LoopStatus::kAccepted) match_of[to_verify[v]] = chosen[v];
+    if (verified[v].status != LoopStatus::kAccepted) continue;
+    match_of[to_verify[v]] = chosen[v];
+    heading_of[to_verify[v]] = RelativeHeading(verified[v].match_from_query);
   }
+  const double max_turn = o.consistency_yaw_deg * M_PI / 180.0;
   for (size_t v = 0; v < verified.size(); ++v) {
     LoopCandidate& c = verified[v];
     if (c.status != LoopStatus::kAccepted) continue;
@@ -253,9 +265,12 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes,
     for (int back = 1; consistent && back < o.consistency; ++back) {
       const auto& now = match_of[q - back + 1];
       const auto& before = match_of[q - back];
-      consistent =
-          now && before &&
-          std::abs(static_cast<long>(*now) - static_cast<long>(*before)) <= o.consistency_keyframes;
+      const double turn =
+          std::remainder(heading_of[q - back + 1] - heading_of[q - back], 2.0 * M_PI);
+      consistent = now && before &&
+                   std::abs(static_cast<long>(*now) - static_cast<long>(*before)) <=
+                       o.consistency_keyframes &&
+                   std::abs(turn) <= max_turn;
     }
     if (!consistent) c.status = LoopStatus::kInconsistent;
   }

@@ -54,6 +54,7 @@ struct LidarLoopOptions {
   // verified matches within consistency_keyframes keyframes of each other's.
   int consistency = 2;
   int consistency_keyframes = 3;
+  double consistency_yaw_deg = 30.0;  // ... and relative headings within this of each other's.
   void Check() const;
 };
 
@@ -123,6 +124,8 @@ lidar::RegistrationResult RegisterLoopScans(const lidar::ScanSurface& query,
 // ... and its status against the bounds (accepted, registration failed, residual, too far).
 LoopStatus RegistrationStatus(const lidar::RegistrationResult& registration,
                               const LidarLoopOptions& options);
+// Heading of the query relative to the match (about the camera's vertical, left positive; rad).
+double RelativeHeading(const Rigid3d& match_from_query);
 // Path length along the keyframes' trajectory at every keyframe.
 std::vector<double> PathLengths(const Trajectory& keyframes);
 // The drift bound: keyframes q and m lie further apart in the trajectory than

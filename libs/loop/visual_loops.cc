@@ -188,8 +188,7 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
     c.status = LoopStatus::kDisagree;
   }
   // Heading of the query relative to the match (about the camera's vertical, left positive).
-  const Eigen::Vector3d forward = c.match_from_query.rotation() * Eigen::Vector3d::UnitZ();
-  c.yaw_rad = std::atan2(-forward.x(), forward.z());
+  c.yaw_rad = RelativeHeading(c.match_from_query);
   return c;
 }
 
