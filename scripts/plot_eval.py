@@ -47,6 +47,7 @@ def plot_top_view(data, name, path):
             xyz = np.asarray(seq["est_xyz"])
             if len(xyz):
                 ax.plot(xyz[:, 0], xyz[:, 2], "-", lw=1.2, label=est["label"])
+    plot_loops(data, name, ax)
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("z (m)")
@@ -56,6 +57,28 @@ def plot_top_view(data, name, path):
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+LOOP_STYLE = {"LiDAR": ("tab:red", "x"), "visual": ("tab:blue", "+"), "both": ("tab:purple", "o")}
+
+
+def plot_loops(data, name, ax):
+    """Accepted loops (evaluate --loops): query and match joined on the ground truth."""
+    loops = data.get("loops", [])
+    if not loops:
+        return
+    seq = next(s for e in data["estimates"] for s in e["sequences"] if s["name"] == name)
+    where = {f: p for f, p in zip(seq.get("gt_frames", []), seq["gt_xyz"])}
+    drawn = set()
+    for query, match, detector in loops:
+        if query not in where or match not in where:
+            continue
+        colour, marker = LOOP_STYLE.get(detector, ("tab:gray", "."))
+        q, m = where[query], where[match]
+        ax.plot([q[0], m[0]], [q[2], m[2]], "-", color=colour, lw=0.8, alpha=0.7)
+        label = None if detector in drawn else "loops (%s)" % detector
+        ax.plot(q[0], q[2], marker, color=colour, ms=5, label=label)
+        drawn.add(detector)
 
 
 def plot_ape_along(data, name, path):

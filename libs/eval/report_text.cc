@@ -181,6 +181,7 @@ nlohmann::json PlotData(const std::vector<EstimateEval>& estimates, const EvalOp
         gt.push_back(xyz(s.paired.gt[i]));
         if (s.paired.has_est[i]) est.push_back(xyz(s.paired.est[i]));
       }
+      js["gt_frames"] = s.paired.frames;
       js["gt_xyz"] = std::move(gt);
       js["est_xyz"] = std::move(est);
       js["ape_frames"] = s.ape.frames;

@@ -9,6 +9,7 @@
 #include "app/tool.h"
 #include "eval/report.h"
 #include "io/eval_report_io.h"
+#include "io/loops_io.h"
 #include "run.h"
 
 int main(int argc, char** argv) {
@@ -17,7 +18,7 @@ int main(int argc, char** argv) {
                       "segment metric (t_rel %, r_rel deg/100m).");
   jvl::tools::EvaluateConfig c;
   std::string align = "none", assoc = "frame", rpe_unit = "frames";
-  std::string json, markdown, plot_dir, plot_script, python;
+  std::string json, markdown, plot_dir, plot_script, python, loops_path;
   CLI::App& cli = tool.cli();
   tool.InputFile(cli.add_option("--gt", c.gt,
                                 "Ground truth: trajectory file (KITTI/TUM/.h5) or folder of them")
@@ -50,6 +51,9 @@ int main(int argc, char** argv) {
   cli.add_option("--plot-dir", plot_dir, "Write PNG plots here (needs python3-matplotlib)");
   cli.add_option("--plot-script", plot_script, "Plotting script (default: scripts/plot_eval.py)");
   cli.add_option("--python", python, "Python interpreter for the plots (default: python3)");
+  cli.add_option("--loops", loops_path,
+                 "loops artifact (loop_detect): the trajectory plot marks its accepted loops "
+                 "(query and match on the ground truth, by detector)");
   return tool.Run(argc, argv, [&] {
     c.options.alignment = jvl::eval::ParseAlignment(align);
     c.options.association.mode = jvl::eval::ParseAssociationMode(assoc);
@@ -68,8 +72,23 @@ int main(int argc, char** argv) {
       jvl::io::WriteTextFileAtomic(markdown, jvl::eval::FormatMarkdown(run.estimates, c.options));
     }
     if (!plot_dir.empty()) {
-      jvl::tools::MakePlots(plot_dir, jvl::eval::PlotData(run.estimates, c.options), plot_script,
-                            plot_python);
+      nlohmann::json plot_data = jvl::eval::PlotData(run.estimates, c.options);
+      if (!loops_path.empty()) {
+        tool.AddInput(loops_path, /*same_dataset=*/false);
+        // Accepted loops (status 0) as [query, match, detector]; "both" where the other
+        // detector closed the same query too (its loop kept as a duplicate, status 8).
+        const jvl::io::LoopsData loops = jvl::io::ReadLoopsArtifact(loops_path);
+        nlohmann::json marks = nlohmann::json::array();
+        for (const jvl::io::LoopRecord& r : loops.loops) {
+          if (r.status != 0) continue;
+          bool both = false;
+          for (const jvl::io::LoopRecord& d : loops.loops)
+            both |= d.status == 8 && d.query == r.query;
+          marks.push_back({r.query, r.match, both ? "both" : r.detector == 1 ? "visual" : "LiDAR"});
+        }
+        plot_data["loops"] = std::move(marks);
+      }
+      jvl::tools::MakePlots(plot_dir, plot_data, plot_script, plot_python);
     }
     spdlog::info("evaluated {} estimate(s) in {:.3f} s", run.estimates.size(),
                  tool.MakeProvenance().wall_time_s);
