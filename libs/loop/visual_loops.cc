@@ -32,6 +32,8 @@ void VisualLoopOptions::Check() const {
   JVL_CHECK(max_reprojection_px > 0 && ransac_iterations >= 1,
             "max_reprojection_px must be > 0 and ransac_iterations >= 1");
   JVL_CHECK(min_inliers >= 4, "min_inliers must be >= 4, got " << min_inliers);
+  JVL_CHECK(point_max_error_sigmas > 0,
+            "point_max_error_sigmas must be > 0, got " << point_max_error_sigmas);
   JVL_CHECK(max_disagreement_m > 0 && max_disagreement_deg > 0,
             "max_disagreement_m and max_disagreement_deg must be > 0");
 }
@@ -187,6 +189,20 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
        RotationAngle(moved.rotation()) * kRadToDeg > o.max_disagreement_deg)) {
     c.status = LoopStatus::kDisagree;
   }
+  // The points kept for the global optimisation: the inliers that the registered pose also
+  // projects within point_max_error_sigmas pyramid-level sigmas of their query pixel (a depth
+  // taken across an edge, or a match the image's pose tolerated, is left out).
+  const Rigid3d query_from_match = c.match_from_query.Inverse();
+  const std::vector<double> scales = vision::LevelScales(o.orb);
+  std::vector<LoopPoint> kept;
+  for (const LoopPoint& p : c.points) {
+    const Eigen::Vector3d x = query_from_match * p.p_match;
+    const double sigma = scales[static_cast<size_t>(
+        std::clamp(p.query_octave, 0, static_cast<int>(scales.size()) - 1))];
+    if (x.z() > 0 && (camera.Project(x) - p.query_uv).norm() <= o.point_max_error_sigmas * sigma)
+      kept.push_back(p);
+  }
+  c.points = std::move(kept);
   // Heading of the query relative to the match (about the camera's vertical, left positive).
   c.yaw_rad = RelativeHeading(c.match_from_query);
   return c;

@@ -54,6 +54,9 @@ struct VisualLoopOptions {
   // The scan registration from the image's pose must stay this close to it.
   double max_disagreement_m = 1.0;
   double max_disagreement_deg = 5.0;
+  // Points stored for the global optimisation: inliers within this many sigmas (the pyramid
+  // level's scale, px) of their query pixel at the registered pose.
+  double point_max_error_sigmas = 2.0;
   // Registration bounds and the trajectory's drift bound (the LiDAR detector's fields:
   // preprocess, surface, association, registration, coarse_scale, max_residual,
   // min_correspondences, max_translation, max_prior_offset, max_prior_drift).

@@ -818,7 +818,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   }
   result.keyframes = input.keyframes;
   SelectVisualTerm(options, &input, &result);
-  if (options.use_loops && !input.loops.empty()) {
+  if (options.use_loops && options.use_loop_points && !input.loops.empty()) {
     result.loop_visual = AddLoopPoints(&input);
     if (result.loop_visual > 0)
       spdlog::info("loops: {} visual observations of {} loop points", result.loop_visual,
