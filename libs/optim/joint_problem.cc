@@ -179,7 +179,8 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
   for (size_t k = 0; k < observations.size(); ++k) {
     if (!keep[k]) continue;
     const VisualObservation& obs = observations[k];
-    if (drop_weak && weak[obs.map_point]) {
+    if ((drop_weak || static_cast<size_t>(obs.map_point) >= input.drop_weak_from) && check_weak &&
+        weak[obs.map_point]) {
       ++jp.gated_observations;
       continue;
     }

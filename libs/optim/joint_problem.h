@@ -88,6 +88,9 @@ struct JointProblemInput {
   // If set, used instead of `observations` (a caller that keeps millions of observations across
   // several solves passes them without a copy; they must outlive the build).
   const std::vector<VisualObservation>* shared_observations = nullptr;
+  // Map points from this row on are left out, not held, when weak (max_point_sigma_ratio): a
+  // point placed through an uncertain pose must not anchor the solution where it was put.
+  size_t drop_weak_from = static_cast<size_t>(-1);
   const std::vector<VisualObservation>& Observations() const {
     return shared_observations != nullptr ? *shared_observations : observations;
   }

@@ -186,7 +186,8 @@ TEST(JointProblem, VisualGateLeavesOutOutliersAndPointsWithoutDepth) {
   // Points of the toy seen only once: a free point then has no depth and is left out too.
   std::map<int32_t, int> seen;
   for (const auto& o : in.observations) ++seen[o.map_point];
-  const int64_t single = std::count_if(seen.begin(), seen.end(), [](auto& s) { return s.second == 1; });
+  const int64_t single =
+      std::count_if(seen.begin(), seen.end(), [](auto& s) { return s.second == 1; });
   options.visual_gate_chi2 = 5.991;
   JointProblem free_points = BuildJointProblem(in, options);
   // The bad observations go, and with them the two points, left with one observation each.
@@ -251,6 +252,15 @@ TEST(JointProblem, PointsWithoutDepthInformationAreHeldConstant) {
   EXPECT_FALSE(dropped.problem->HasParameterBlock(dropped.map_points[far].data()));
   EXPECT_FALSE(dropped.problem->IsParameterBlockConstant(dropped.map_points[near].data()));
   options.drop_weak_points = false;
+
+  // Dropped only from drop_weak_from on (the global problem's loop points): the far point is
+  // the first such row, so it leaves the problem while the others are treated as before.
+  in.drop_weak_from = static_cast<size_t>(far);
+  JointProblem from_far = BuildJointProblem(in, options);
+  EXPECT_FALSE(from_far.problem->HasParameterBlock(from_far.map_points[far].data()));
+  EXPECT_FALSE(from_far.problem->IsParameterBlockConstant(from_far.map_points[near].data()));
+  EXPECT_EQ(from_far.gated_observations, held.gated_observations + 2);
+  in.drop_weak_from = static_cast<size_t>(-1);
 
   options.optimize_map_points = false;  // fixed map points: nothing to hold, nothing counted
   EXPECT_EQ(BuildJointProblem(in, options).weak_points, 0);

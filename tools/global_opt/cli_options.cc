@@ -57,8 +57,9 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
              "Vertical prior: its sigma in degrees as given (0: from --vertical-bias)");
   method.Flag("!--no-loops", o->use_loops, "Leave out the loops of --loops (ablation)");
   method.Flag("--loop-points,!--no-loop-points", o->use_loop_points,
-              "Also put the visual loops' points (PnP inliers) into the visual term, observed by "
-              "both ends (off by default: worse on the measured loop drive, docs/loop_detect.md)");
+              "Put the visual loops' points (PnP inliers) into the visual term, observed by both "
+              "ends; weak ones left out (--no-loop-points: the loops' correction and IMLS term "
+              "only)");
   method.Flag("!--no-odometry", o->use_odometry,
               "Leave out the odometry term e_O (the paper's energy; ablation)");
   method.Add("--odometry-gate", o->odometry_gate,

@@ -818,6 +818,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   }
   result.keyframes = input.keyframes;
   SelectVisualTerm(options, &input, &result);
+  const size_t first_loop_point = input.map_points.size();
   if (options.use_loops && options.use_loop_points && !input.loops.empty()) {
     result.loop_visual = AddLoopPoints(&input);
     if (result.loop_visual > 0)
@@ -830,6 +831,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   problem.fixed = {0};  // gauge: the first keyframe
   problem.map_points = input.map_points;
   problem.shared_observations = &input.observations;
+  problem.drop_weak_from = first_loop_point;  // Loop points are dropped, not held, when weak.
   optim::JointProblemOptions joint = options.joint;  // direction sigma set once e_D enters
   DirectionTerm direction;
   OdometryTerm odometry;

@@ -183,10 +183,10 @@ struct GlobalMappingOptions {
   // correspondences of the query scan against the scans of the keyframes within
   // traversal.scan_map_size frames of the match (false: the --no-loops ablation).
   bool use_loops = true;
-  // The visual loops' points in the visual term (AddLoopPoints). Off by default: on the 1.7 km
-  // loop drive of docs/loop_detect.md they made the result worse (APE 0.052 -> 0.071 m without
-  // direction priors) than the loops' correction and IMLS term alone.
-  bool use_loop_points = false;
+  // The visual loops' points in the visual term (AddLoopPoints); those whose two views do not
+  // fix their depth are left out (held at the place they were put, they anchored the solution
+  // there: docs/loop_detect.md).
+  bool use_loop_points = true;
   void Check() const;
 
   // Preset for inputs whose map points are not consistent with the poses (e.g. placed from the
