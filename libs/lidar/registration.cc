@@ -151,7 +151,13 @@ RegistrationResult RegisterScan(const std::vector<Eigen::Vector3d>& points, cons
 RegistrationResult RegisterSurface(const ScanSurface& surface, const ImlsModel& model,
                                    const Rigid3d& start, const AssociationOptions& association,
                                    const RegistrationOptions& options, int threads, int* samples) {
-  const SampledScan scan = SampleSurface(surface, association.samples_per_list);
+  return RegisterSampled(SampleSurface(surface, association.samples_per_list), model, start,
+                         association, options, threads, samples);
+}
+
+RegistrationResult RegisterSampled(const SampledScan& scan, const ImlsModel& model,
+                                   const Rigid3d& start, const AssociationOptions& association,
+                                   const RegistrationOptions& options, int threads, int* samples) {
   const std::vector<int> picked = SelectSamples(scan, start, model, association);
   std::vector<Eigen::Vector3d> points;
   std::vector<double> planarity;

@@ -60,6 +60,12 @@ RegistrationResult RegisterSurface(const ScanSurface& surface, const ImlsModel& 
                                    const RegistrationOptions& options, int threads,
                                    int* samples = nullptr);
 
+// The same from a scan already sampled (SampleSurface), for a scan registered several times.
+RegistrationResult RegisterSampled(const SampledScan& scan, const ImlsModel& model,
+                                   const Rigid3d& start, const AssociationOptions& association,
+                                   const RegistrationOptions& options, int threads,
+                                   int* samples = nullptr);
+
 // The neighbourhoods of a coarse registration without a motion estimate: search radius,
 // kernel h, max distance and robust scale multiplied by k (samples per list unchanged).
 void ScaleNeighbourhoods(double k, AssociationOptions* association, RegistrationOptions* options);

@@ -1,5 +1,7 @@
 #include "loop/lidar_loops.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -24,6 +26,8 @@ void LidarLoopOptions::Check() const {
   JVL_CHECK(max_descriptor_distance > 0 && max_descriptor_distance <= 1,
             "max_descriptor_distance must be in (0, 1], got " << max_descriptor_distance);
   JVL_CHECK(coarse_scale >= 1, "coarse_scale must be >= 1, got " << coarse_scale);
+  JVL_CHECK(std::isfinite(coarse_voxel) && coarse_voxel >= 0,
+            "coarse_voxel must be >= 0, got " << coarse_voxel);
   JVL_CHECK(max_residual > 0, "max_residual must be > 0, got " << max_residual);
   JVL_CHECK(min_correspondences >= 1,
             "min_correspondences must be >= 1, got " << min_correspondences);
@@ -32,8 +36,9 @@ void LidarLoopOptions::Check() const {
             "max_prior_offset must be > 0 and max_prior_drift >= 0, got "
                 << max_prior_offset << " and " << max_prior_drift);
   JVL_CHECK(consistency >= 1, "consistency must be >= 1, got " << consistency);
-  JVL_CHECK(consistency_yaw_deg > 0 && consistency_yaw_deg <= 180,
-            "consistency_yaw_deg must be in (0, 180], got " << consistency_yaw_deg);
+  JVL_CHECK(consistency_m > 0 && consistency_deg > 0 && consistency_deg <= 180,
+            "consistency_m must be > 0 and consistency_deg in (0, 180], got "
+                << consistency_m << " and " << consistency_deg);
   JVL_CHECK(consistency_keyframes >= 0,
             "consistency_keyframes must be >= 0, got " << consistency_keyframes);
 }
@@ -62,31 +67,96 @@ const char* ToString(LoopStatus status) {
   return "unknown";
 }
 
-lidar::RegistrationResult RegisterLoopScans(const lidar::ScanSurface& query,
-                                            const lidar::ScanSurface& match, const Rigid3d& initial,
-                                            const LidarLoopOptions& o) {
-  auto run = [&](const lidar::AssociationOptions& association,
-                 const lidar::RegistrationOptions& registration, const Rigid3d& start) {
-    lidar::ImlsModel model(association.search_radius);
-    lidar::AddScanToModel(match.points, match.normals, Rigid3d(), 0, &model);
-    return lidar::RegisterSurface(query, model, start, association, registration, 1);
-  };
-  Rigid3d start = initial;
+namespace {
+
+lidar::ScanSurface PreparedSurface(const PointCloud& scan, const Calibration& calibration,
+                                   const LidarLoopOptions& o) {
+  const lidar::PreprocessedScan pre =
+      lidar::PreprocessScan(scan, calibration.cam0_from_velo, o.preprocess, 1);
+  return lidar::ComputeSurface(pre.points, o.surface, 1);
+}
+
+}  // namespace
+
+LoopScan::LoopScan(const PointCloud& scan, const Calibration& calibration,
+                   const LidarLoopOptions& o)
+    : samples(lidar::SampleSurface(PreparedSurface(scan, calibration, o),
+                                   o.association.samples_per_list)),
+      model(o.association.search_radius),
+      coarse_model(o.association.search_radius * o.coarse_scale) {
+  lidar::AddScanToModel(samples.points, samples.normals, Rigid3d(), 0, &model);
+  if (o.coarse_scale > 1) {
+    const lidar::StoredScan thinned = lidar::StoreScan(samples, o.coarse_voxel);
+    lidar::AddScanToModel(thinned.points, thinned.normals, Rigid3d(), 0, &coarse_model);
+  }
+}
+
+lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopScan& match,
+                                            const Rigid3d& initial, const LidarLoopOptions& o) {
+  return RegisterLoopScans(query, match, std::vector<Rigid3d>{initial}, o);
+}
+
+lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopScan& match,
+                                            const std::vector<Rigid3d>& initials,
+                                            const LidarLoopOptions& o, size_t* chosen) {
+  JVL_CHECK(!initials.empty(), "RegisterLoopScans needs a start");
+  size_t best = 0;
+  Rigid3d start = initials[0];
   if (o.coarse_scale > 1) {
     lidar::AssociationOptions coarse = o.association;
     lidar::RegistrationOptions coarse_registration = o.registration;
     lidar::ScaleNeighbourhoods(o.coarse_scale, &coarse, &coarse_registration);
-    const lidar::RegistrationResult first = run(coarse, coarse_registration, initial);
-    if (first.ok) start = first.world_from_scan;
+    // The best coarse result: converged without a degenerate direction first, then the lower
+    // residual.
+    auto rank = [](const lidar::RegistrationResult& r) {
+      return std::make_pair(r.ok && r.converged && !r.degenerate ? 0 : r.ok ? 1 : 2, r.residual);
+    };
+    std::optional<lidar::RegistrationResult> kept;
+    for (size_t i = 0; i < initials.size(); ++i) {
+      const lidar::RegistrationResult first = lidar::RegisterSampled(
+          query.samples, match.coarse_model, initials[i], coarse, coarse_registration, 1);
+      if (!kept || rank(first) < rank(*kept)) {
+        kept = first;
+        best = i;
+        start = first.ok ? first.world_from_scan : initials[i];
+      }
+    }
   }
-  return run(o.association, o.registration, start);
+  if (chosen) *chosen = best;
+  return lidar::RegisterSampled(query.samples, match.model, start, o.association, o.registration,
+                                1);
 }
 
-lidar::ScanSurface LoopSurface(const PointCloud& scan, const Calibration& calibration,
-                               const LidarLoopOptions& o) {
-  const lidar::PreprocessedScan pre =
-      lidar::PreprocessScan(scan, calibration.cam0_from_velo, o.preprocess, 1);
-  return lidar::ComputeSurface(pre.points, o.surface, 1);
+LoopScanCache::LoopScanCache(std::function<PointCloud(int64_t)> load_scan,
+                             const Calibration& calibration, const LidarLoopOptions& options,
+                             size_t capacity)
+    : load_scan_(std::move(load_scan)),
+      calibration_(calibration),
+      options_(options),
+      capacity_(std::max<size_t>(capacity, 1)) {}
+
+std::shared_ptr<const LoopScan> LoopScanCache::Get(int64_t frame) {
+  std::shared_ptr<Slot> slot;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    auto it = slots_.find(frame);
+    if (it != slots_.end()) {
+      recent_.erase(it->second.second);
+    } else {
+      it = slots_.emplace(frame, std::make_pair(std::make_shared<Slot>(), recent_.end())).first;
+    }
+    recent_.push_front(frame);
+    it->second.second = recent_.begin();
+    slot = it->second.first;
+    while (recent_.size() > capacity_) {  // The slot's holders keep its scan alive.
+      slots_.erase(recent_.back());
+      recent_.pop_back();
+    }
+  }
+  const std::lock_guard<std::mutex> lock(slot->mutex);
+  if (!slot->scan)
+    slot->scan = std::make_shared<const LoopScan>(load_scan_(frame), calibration_, options_);
+  return slot->scan;
 }
 
 LoopStatus RegistrationStatus(const lidar::RegistrationResult& reg, const LidarLoopOptions& o) {
@@ -100,6 +170,12 @@ LoopStatus RegistrationStatus(const lidar::RegistrationResult& reg, const LidarL
 double RelativeHeading(const Rigid3d& match_from_query) {
   const Eigen::Vector3d forward = match_from_query.rotation() * Eigen::Vector3d::UnitZ();
   return std::atan2(-forward.x(), forward.z());
+}
+
+Rigid3d LoopDisagreement(const Rigid3d& query1, const Rigid3d& match1, const Rigid3d& loop1,
+                         const Rigid3d& query2, const Rigid3d& match2, const Rigid3d& loop2) {
+  const Rigid3d predicted = match2.Inverse() * match1 * loop1 * query1.Inverse() * query2;
+  return loop2.Inverse() * predicted;
 }
 
 std::vector<double> PathLengths(const Trajectory& keyframes) {
@@ -120,9 +196,8 @@ bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, si
   return apart > o.max_prior_offset + o.max_prior_drift * (path[q] - path[m]);
 }
 
-LoopResult DetectLidarLoops(const Trajectory& keyframes,
-                            const std::function<PointCloud(int64_t)>& load_scan,
-                            const Calibration& calibration, const LidarLoopOptions& o, int threads,
+LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
+                            const LidarLoopOptions& o, int threads,
                             const std::function<void()>& tick) {
   o.Check();
   keyframes.Check("loop keyframes");
@@ -132,7 +207,7 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes,
   const std::vector<double> path = PathLengths(keyframes);
   std::vector<ScanDescriptor> descriptors(n);
   ParallelFor(static_cast<int64_t>(n), threads, [&](int64_t i) {
-    descriptors[i] = ComputeScanDescriptor(load_scan(keyframes.frames[i]).points, o.descriptor);
+    descriptors[i] = ComputeScanDescriptor(scans.Load(keyframes.frames[i]).points, o.descriptor);
     if (tick) tick();
   });
 
@@ -175,14 +250,32 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes,
     }
   });
 
-  // Verification of every pick (independent, in parallel; results in their slots).
+  // A pick can only become a loop if a neighbouring keyframe has a pick within
+  // consistency_keyframes of it (the temporal consistency below needs consecutive matches that
+  // agree); the others are not verified.
+  if (o.consistency > 1) {
+    auto agrees = [&](const Pick& pick, size_t other) {
+      for (const Pick& p : picks[other])
+        if (std::abs(static_cast<long>(p.match) - static_cast<long>(pick.match)) <=
+            o.consistency_keyframes)
+          return true;
+      return false;
+    };
+    std::vector<std::vector<Pick>> kept(n);
+    for (size_t q = 0; q < n; ++q)
+      for (const Pick& pick : picks[q])
+        if ((q > 0 && agrees(pick, q - 1)) || (q + 1 < n && agrees(pick, q + 1)))
+          kept[q].push_back(pick);
+    picks = std::move(kept);
+  }
+
+  // Verification of every keyframe's picks (independent, in parallel; results in their slots).
   std::vector<size_t> to_verify;
   for (size_t q = 0; q < n; ++q)
     if (!picks[q].empty()) to_verify.push_back(q);
   std::vector<LoopCandidate> verified(to_verify.size());
   std::vector<size_t> chosen(to_verify.size());  // Keyframe index of each verified match.
-  const Rigid3d& cam0_from_velo = calibration.cam0_from_velo;
-  auto surface_of = [&](int64_t frame) { return LoopSurface(load_scan(frame), calibration, o); };
+  const Rigid3d& cam0_from_velo = scans.calibration().cam0_from_velo;
   // Query points = Rz(yaw) match points (velodyne frames): velo_match_from_velo_query is
   // Rz(-yaw).
   auto initial_for = [&](double yaw) {
@@ -193,28 +286,22 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes,
   };
   auto status_of = [&](const lidar::RegistrationResult& reg) { return RegistrationStatus(reg, o); };
   // One candidate, registered from its best yaw and from the opposite one.
-  auto VerifyPick = [&](const Pick& pick, size_t q, const lidar::ScanSurface& query_surface) {
+  auto VerifyPick = [&](const Pick& pick, size_t q, const LoopScan& query_scan) {
     LoopCandidate c;
     c.query = keyframes.frames[q];
     c.match = keyframes.frames[pick.match];
     c.ring_key_distance = pick.ring;
     c.descriptor_distance = pick.m.distance;
-    const lidar::ScanSurface match_surface = surface_of(c.match);
-    double yaw = pick.m.yaw;
-    lidar::RegistrationResult reg =
-        RegisterLoopScans(query_surface, match_surface, initial_for(yaw), o);
+    const std::shared_ptr<const LoopScan> match_scan = scans.Get(c.match);
+    // From the descriptor's yaw and from the other way round (a street seen from the other
+    // direction matches itself turned by 180 deg and shifted across the road nearly as well):
+    // the better coarse registration is refined.
+    size_t which = 0;
+    const lidar::RegistrationResult reg =
+        RegisterLoopScans(query_scan, *match_scan,
+                          {initial_for(pick.m.yaw), initial_for(pick.opposite.yaw)}, o, &which);
     LoopStatus status = status_of(reg);
-    // Both ways round: a street seen from the other direction matches itself turned by 180 deg
-    // and shifted across the road nearly as well; the lower residual decides.
-    const lidar::RegistrationResult other =
-        RegisterLoopScans(query_surface, match_surface, initial_for(pick.opposite.yaw), o);
-    const LoopStatus other_status = status_of(other);
-    if (other_status == status ? other.residual < reg.residual
-                               : other_status == LoopStatus::kAccepted) {
-      reg = other;
-      status = other_status;
-      yaw = pick.opposite.yaw;
-    }
+    const double yaw = which == 0 ? pick.m.yaw : pick.opposite.yaw;
     c.yaw_rad = yaw;
     c.match_from_query = reg.world_from_scan;
     c.correspondences = reg.correspondences;
@@ -228,49 +315,54 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes,
   };
   ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t v) {
     const size_t q = to_verify[v];
-    const lidar::ScanSurface query_surface = surface_of(keyframes.frames[q]);
-    bool have = false;
-    for (const Pick& pick : picks[q]) {
-      LoopCandidate c = VerifyPick(pick, q, query_surface);
-      const LoopCandidate& kept = verified[v];
-      const bool better =
-          !have || (c.status == LoopStatus::kAccepted &&
-                    (kept.status != LoopStatus::kAccepted || c.residual < kept.residual));
-      if (better) {
+    const std::shared_ptr<const LoopScan> query_scan = scans.Get(keyframes.frames[q]);
+    // Nearest by descriptor first; the first accepted one is kept, else the first rejected.
+    for (size_t k = 0; k < picks[q].size(); ++k) {
+      LoopCandidate c = VerifyPick(picks[q][k], q, *query_scan);
+      if (k == 0 || c.status == LoopStatus::kAccepted) {
         verified[v] = c;
-        chosen[v] = pick.match;
-        have = true;
+        chosen[v] = picks[q][k].match;
       }
+      if (c.status == LoopStatus::kAccepted) break;
     }
     if (tick) tick();
   });
 
   // Temporal consistency: a verified match is accepted when the consistency - 1 keyframes
   // before its query have verified matches too, each within consistency_keyframes keyframes of
-  // the next one's and turned the same way (registered headings within consistency_yaw_deg: a
-  // street end registered the wrong way round among right ones is not a loop).
+  // the next one's and agreeing with it in geometry: the relative pose of the later loop
+  // predicted from the earlier one and the trajectory's motion between the two queries and
+  // between the two matches (a few metres each, where odometry is accurate) must be within
+  // consistency_m and consistency_deg of the registered one. A street end registered the wrong
+  // way round, or a registration slid along a street, among right ones is not a loop.
   std::vector<std::optional<size_t>> match_of(n);  // Keyframe index of a verified match.
-  std::vector<double> heading_of(n, 0.0);          // Its registered relative heading.
+  std::vector<Rigid3d> loop_of(n);                 // Its registered match_from_query.
   for (size_t v = 0; v < verified.size(); ++v) {
     if (verified[v].status != LoopStatus::kAccepted) continue;
     match_of[to_verify[v]] = chosen[v];
-    heading_of[to_verify[v]] = RelativeHeading(verified[v].match_from_query);
+    loop_of[to_verify[v]] = verified[v].match_from_query;
   }
-  const double max_turn = o.consistency_yaw_deg * M_PI / 180.0;
+  const std::vector<Rigid3d>& pose = keyframes.world_from_cam;  // Only relative motions used.
   for (size_t v = 0; v < verified.size(); ++v) {
     LoopCandidate& c = verified[v];
     if (c.status != LoopStatus::kAccepted) continue;
     const size_t q = to_verify[v];
     bool consistent = q + 1 >= static_cast<size_t>(o.consistency);
     for (int back = 1; consistent && back < o.consistency; ++back) {
-      const auto& now = match_of[q - back + 1];
-      const auto& before = match_of[q - back];
-      const double turn =
-          std::remainder(heading_of[q - back + 1] - heading_of[q - back], 2.0 * M_PI);
-      consistent = now && before &&
-                   std::abs(static_cast<long>(*now) - static_cast<long>(*before)) <=
-                       o.consistency_keyframes &&
-                   std::abs(turn) <= max_turn;
+      const size_t q2 = q - back + 1, q1 = q - back;
+      const auto& now = match_of[q2];
+      const auto& before = match_of[q1];
+      consistent =
+          now && before &&
+          std::abs(static_cast<long>(*now) - static_cast<long>(*before)) <= o.consistency_keyframes;
+      if (!consistent) break;
+      const Rigid3d off =
+          LoopDisagreement(pose[q1], pose[*before], loop_of[q1], pose[q2], pose[*now], loop_of[q2]);
+      const double off_deg = RotationAngle(off.rotation()) * kRadToDeg;
+      spdlog::debug("consistency {} -> {} after {} -> {}: {:.3f} m, {:.2f} deg",
+                    keyframes.frames[q2], keyframes.frames[*now], keyframes.frames[q1],
+                    keyframes.frames[*before], off.translation().norm(), off_deg);
+      consistent = off.translation().norm() <= o.consistency_m && off_deg <= o.consistency_deg;
     }
     if (!consistent) c.status = LoopStatus::kInconsistent;
   }

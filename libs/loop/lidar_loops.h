@@ -1,15 +1,20 @@
 // The LiDAR loop detector: place recognition with the polar height descriptor
 // (scan_descriptor.h), geometric verification by IMLS registration of the two scans (the
-// registration of lidar_odom, lidar/registration.h) from the descriptor's best yaw and, if that
-// fails, from the best yaw near the opposite direction (a street looks much the same both ways
-// round), a bound on the trajectory's drift, and temporal consistency over consecutive
-// keyframes. One of the loop stage's detectors (loop_detect); it never looks at the trajectory's
-// positions to find a candidate, only at its path length to skip the keyframes just driven.
+// registration of lidar_odom, lidar/registration.h) from the descriptor's best yaw or from the
+// best yaw near the opposite direction (a street looks much the same both ways round), a bound
+// on the trajectory's drift, and temporal consistency over consecutive keyframes, in geometry.
+// One of the loop stage's detectors (loop_detect); it never looks at the trajectory's positions
+// to find a candidate, only at its path length to skip the keyframes just driven and at its
+// motion between consecutive keyframes to check that consecutive loops agree.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <list>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "geometry/calibration.h"
@@ -17,12 +22,15 @@
 #include "geometry/rigid3.h"
 #include "geometry/trajectory.h"
 #include "lidar/association.h"
+#include "lidar/imls.h"
 #include "lidar/preprocess.h"
 #include "lidar/registration.h"
 #include "lidar/surface.h"
 #include "loop/scan_descriptor.h"
 
 namespace jvl::loop {
+
+inline constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 struct LidarLoopOptions {
   ScanDescriptorOptions descriptor;
@@ -42,6 +50,9 @@ struct LidarLoopOptions {
   lidar::AssociationOptions association;
   lidar::RegistrationOptions registration;
   double coarse_scale = 4.0;
+  // The coarse pass registers on the match's surface thinned to one point per voxel of this
+  // size (m; 0 = every point): its neighbourhoods are coarse_scale times wider.
+  double coarse_voxel = 1.0;
   double max_residual = 0.08;     // m, RMS IMLS distance after registration.
   int min_correspondences = 300;  // At the last iteration.
   double max_translation = 15.0;  // m between the two scans: a revisit, not a place 30 m on.
@@ -54,7 +65,9 @@ struct LidarLoopOptions {
   // verified matches within consistency_keyframes keyframes of each other's.
   int consistency = 2;
   int consistency_keyframes = 3;
-  double consistency_yaw_deg = 30.0;  // ... and relative headings within this of each other's.
+  // ... and agreeing in geometry (see DetectLidarLoops) within these.
+  double consistency_m = 1.0;
+  double consistency_deg = 3.0;
   void Check() const;
 };
 
@@ -103,34 +116,80 @@ struct LoopResult {
   std::vector<LoopCandidate> candidates;  // By query; status kAccepted = a loop.
 };
 
+class LoopScanCache;
+
 // keyframes: the frames to search (increasing) with their poses (only the path length between
 // them is used). load_scan(frame): the scan as read (not de-skewed). calibration: cam0_from_velo
 // for the preprocessing (the descriptor is computed in the velodyne frame). tick() is called
-// once per keyframe described and once per candidate verified (progress).
-LoopResult DetectLidarLoops(const Trajectory& keyframes,
-                            const std::function<PointCloud(int64_t)>& load_scan,
-                            const Calibration& calibration, const LidarLoopOptions& options,
-                            int threads, const std::function<void()>& tick = nullptr);
+// once per keyframe described and once per candidate verified (progress). scans: the prepared
+// scans of the verification (prepared with these options), shared with the visual detector.
+LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
+                            const LidarLoopOptions& options, int threads,
+                            const std::function<void()>& tick = nullptr);
 
-// The verification shared by both detectors. The scan of a keyframe preprocessed as lidar_odom
-// does it (cam0 frame) with its surface ...
-lidar::ScanSurface LoopSurface(const PointCloud& scan, const Calibration& calibration,
-                               const LidarLoopOptions& options);
-// ... `query` registered on the model of `match` from `initial` = match_from_query: a coarse pass
-// with scaled neighbourhoods, then the normal one (as lidar_odom's first pair) ...
-lidar::RegistrationResult RegisterLoopScans(const lidar::ScanSurface& query,
-                                            const lidar::ScanSurface& match, const Rigid3d& initial,
+// The verification shared by both detectors. A keyframe's scan preprocessed as lidar_odom does
+// it (cam0 frame) and its surface, as IMLS-SLAM sampling lists (registered as the query) and as
+// IMLS models at the normal and the coarse neighbourhoods (registered on) ...
+struct LoopScan {
+  LoopScan(const PointCloud& scan, const Calibration& calibration, const LidarLoopOptions& options);
+  lidar::SampledScan samples;
+  lidar::ImlsModel model, coarse_model;
+};
+// ... `query` registered on `match` from `initial` = match_from_query: a coarse pass with
+// scaled neighbourhoods, then the normal one (as lidar_odom's first pair) ...
+lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopScan& match,
+                                            const Rigid3d& initial,
                                             const LidarLoopOptions& options);
+// ... or from the best of several starts: each registered at the coarse neighbourhoods, the
+// best one (converged without a degenerate direction, then the lower residual; its index in
+// *chosen) refined.
+lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopScan& match,
+                                            const std::vector<Rigid3d>& initials,
+                                            const LidarLoopOptions& options,
+                                            size_t* chosen = nullptr);
 // ... and its status against the bounds (accepted, registration failed, residual, too far).
 LoopStatus RegistrationStatus(const lidar::RegistrationResult& registration,
                               const LidarLoopOptions& options);
 // Heading of the query relative to the match (about the camera's vertical, left positive; rad).
 double RelativeHeading(const Rigid3d& match_from_query);
+// Two loops of consecutive queries against each other: loop2 (match_from_query of query2) as
+// loop1 predicts it through the trajectory's motion from query1 to query2 and from match1 to
+// match2 (world_from_cam poses), as the offset loop2^-1 * predicted (identity when they agree).
+Rigid3d LoopDisagreement(const Rigid3d& query1, const Rigid3d& match1, const Rigid3d& loop1,
+                         const Rigid3d& query2, const Rigid3d& match2, const Rigid3d& loop2);
 // Path length along the keyframes' trajectory at every keyframe.
 std::vector<double> PathLengths(const Trajectory& keyframes);
 // The drift bound: keyframes q and m lie further apart in the trajectory than
 // max_prior_offset + max_prior_drift x the path length between them.
 bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, size_t q, size_t m,
                 const LidarLoopOptions& options);
+
+// The prepared scans of the keyframes being verified, each prepared once and kept while it is
+// among the `capacity` most recently used (consecutive queries verify against neighbouring
+// matches; about 2 MB each on KITTI scans). Both detectors may share one. Thread-safe; a scan
+// is prepared outside the cache's lock, once.
+class LoopScanCache {
+ public:
+  LoopScanCache(std::function<PointCloud(int64_t)> load_scan, const Calibration& calibration,
+                const LidarLoopOptions& options, size_t capacity = 256);
+  std::shared_ptr<const LoopScan> Get(int64_t frame);
+  PointCloud Load(int64_t frame) const { return load_scan_(frame); }  // As read, not cached.
+  const LidarLoopOptions& options() const { return options_; }        // The preparation's.
+  const Calibration& calibration() const { return calibration_; }
+
+ private:
+  struct Slot {
+    std::mutex mutex;
+    std::shared_ptr<const LoopScan> scan;
+  };
+  std::function<PointCloud(int64_t)> load_scan_;
+  Calibration calibration_;
+  LidarLoopOptions options_;
+  size_t capacity_;
+  std::mutex mutex_;
+  std::list<int64_t> recent_;  // Most recently used first.
+  std::unordered_map<int64_t, std::pair<std::shared_ptr<Slot>, std::list<int64_t>::iterator>>
+      slots_;
+};
 
 }  // namespace jvl::loop

@@ -40,7 +40,11 @@ void VisualLoopOptions::Check() const {
 
 VisualKeyframe DescribeImage(const cv::Mat& image, const Vocabulary& vocabulary,
                              const VisualLoopOptions& o) {
-  vision::OrbFeatures features = vision::ExtractOrb(image, o.orb);
+  return DescribeFeatures(vision::ExtractOrb(image, o.orb), vocabulary, o);
+}
+
+VisualKeyframe DescribeFeatures(vision::OrbFeatures features, const Vocabulary& vocabulary,
+                                const VisualLoopOptions& o) {
   VisualKeyframe k;
   k.keypoints = std::move(features.keypoints);
   k.descriptors = std::move(features.descriptors);
@@ -52,8 +56,6 @@ VisualKeyframe DescribeImage(const cv::Mat& image, const Vocabulary& vocabulary,
 }
 
 namespace {
-
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 // Matches of query features to match features within the same vocabulary node: the nearest by
 // Hamming distance up to max_hamming and below ratio x the second nearest; each match feature
@@ -126,13 +128,13 @@ double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoop
 }  // namespace
 
 LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
-                                    const PointCloud& query_scan, const PointCloud& match_scan,
+                                    int64_t query_frame, int64_t match_frame, LoopScanCache& scans,
                                     const Calibration& calibration, const VisualLoopOptions& o) {
   LoopCandidate c;
   c.detector = "visual";
   c.status = LoopStatus::kFewInliers;
   const PinholeCamera camera = calibration.Camera(0);
-  const cv::Mat depth = ScanDepth(match_scan, calibration, camera);
+  const cv::Mat depth = ScanDepth(scans.Load(match_frame), calibration, camera);
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   std::vector<LoopPoint> points;
@@ -173,10 +175,8 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
   const Rigid3d image_pose =
       Rigid3d(Eigen::Quaterniond(rotation).normalized(), translation).Inverse();
 
-  const lidar::ScanSurface query_surface = LoopSurface(query_scan, calibration, o.lidar);
-  const lidar::ScanSurface match_surface = LoopSurface(match_scan, calibration, o.lidar);
   const lidar::RegistrationResult reg =
-      RegisterLoopScans(query_surface, match_surface, image_pose, o.lidar);
+      RegisterLoopScans(*scans.Get(query_frame), *scans.Get(match_frame), image_pose, o.lidar);
   c.match_from_query = reg.ok ? reg.world_from_scan : image_pose;
   c.correspondences = reg.correspondences;
   c.residual = reg.residual;
@@ -209,9 +209,8 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
 }
 
 LoopResult DetectVisualLoops(const Trajectory& keyframes,
-                             const std::function<cv::Mat(int64_t)>& load_image,
-                             const std::function<PointCloud(int64_t)>& load_scan,
-                             const Calibration& calibration, const Vocabulary& vocabulary,
+                             const std::function<vision::OrbFeatures(int64_t)>& features_of,
+                             LoopScanCache& scans, const Vocabulary& vocabulary,
                              const VisualLoopOptions& o, int threads,
                              const std::function<void()>& tick) {
   o.Check();
@@ -223,7 +222,7 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
   std::vector<VisualKeyframe> described(n);
   ParallelFor(static_cast<int64_t>(n), threads, [&](int64_t i) {
     described[static_cast<size_t>(i)] =
-        DescribeImage(load_image(keyframes.frames[static_cast<size_t>(i)]), vocabulary, o);
+        DescribeFeatures(features_of(keyframes.frames[static_cast<size_t>(i)]), vocabulary, o);
     if (tick) tick();
   });
 
@@ -309,9 +308,8 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
   std::vector<LoopCandidate> verified(to_verify.size());
   ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t v) {
     const auto [q, m] = to_verify[static_cast<size_t>(v)];
-    LoopCandidate c =
-        VerifyVisualCandidate(described[q], described[m], load_scan(keyframes.frames[q]),
-                              load_scan(keyframes.frames[m]), calibration, o);
+    LoopCandidate c = VerifyVisualCandidate(described[q], described[m], keyframes.frames[q],
+                                            keyframes.frames[m], scans, scans.calibration(), o);
     c.query = keyframes.frames[q];
     c.match = keyframes.frames[m];
     c.descriptor_distance = to_verify_score[static_cast<size_t>(v)];

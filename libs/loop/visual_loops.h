@@ -73,21 +73,27 @@ struct VisualKeyframe {
 };
 VisualKeyframe DescribeImage(const cv::Mat& image, const Vocabulary& vocabulary,
                              const VisualLoopOptions& options);
+// The same from features already extracted (e.g. the visual map's keypoints of the keyframe).
+VisualKeyframe DescribeFeatures(vision::OrbFeatures features, const Vocabulary& vocabulary,
+                                const VisualLoopOptions& options);
 
 // keyframes: the frames to search (increasing) with their poses (only the path length between
-// them and the drift bound use them). load_image(frame): camera 0's image; load_scan(frame): the
-// scan as read. tick() once per keyframe described and once per candidate verified.
+// them and the drift bound use them). features_of(frame): the ORB features of camera 0's image
+// (extracted with options.orb, or the visual map's); scans: the scans (prepared with
+// options.lidar), shared with the LiDAR detector. tick() once per keyframe described and once
+// per candidate verified.
 LoopResult DetectVisualLoops(const Trajectory& keyframes,
-                             const std::function<cv::Mat(int64_t)>& load_image,
-                             const std::function<PointCloud(int64_t)>& load_scan,
-                             const Calibration& calibration, const Vocabulary& vocabulary,
+                             const std::function<vision::OrbFeatures(int64_t)>& features_of,
+                             LoopScanCache& scans, const Vocabulary& vocabulary,
                              const VisualLoopOptions& options, int threads,
                              const std::function<void()>& tick = nullptr);
 
 // One geometric verification (exposed for tests): match_from_query of `query` against `match`
-// (both described), with the match keyframe's scan for depth and both scans for registration.
+// (both described; dataset frames query_frame and match_frame), with the match keyframe's scan
+// for depth and both scans for the registration, from `scans` (prepared with options.lidar;
+// only when the images agree on a pose).
 LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
-                                    const PointCloud& query_scan, const PointCloud& match_scan,
+                                    int64_t query_frame, int64_t match_frame, LoopScanCache& scans,
                                     const Calibration& calibration,
                                     const VisualLoopOptions& options);
 

@@ -37,6 +37,14 @@ struct Pair {
   Rigid3d match_from_query;
 };
 
+// The pair's verification: the query is frame 1, the match frame 0.
+LoopCandidate Verify(const Pair& p, const Calibration& c) {
+  const VisualLoopOptions o;
+  LoopScanCache scans([&](int64_t frame) { return frame == 1 ? p.query_scan : p.match_scan; }, c,
+                      o.lidar);
+  return VerifyVisualCandidate(p.query, p.match, 1, 0, scans, c, o);
+}
+
 // A street seen by the match keyframe at the origin and by the query from `match_from_query`;
 // the features are scene points seen by both, each with its own random descriptor (all in one
 // vocabulary node).
@@ -87,8 +95,7 @@ TEST(VisualLoops, VerificationRecoversARevisit) {
                       Eigen::Vector3d(1.0, 0.05, 2.0));
   const Pair p = StreetPair(truth, c);
   ASSERT_GT(p.query.keypoints.size(), 100u);
-  const LoopCandidate got =
-      VerifyVisualCandidate(p.query, p.match, p.query_scan, p.match_scan, c, VisualLoopOptions{});
+  const LoopCandidate got = Verify(p, c);
   EXPECT_EQ(got.status, LoopStatus::kAccepted) << ToString(got.status);
   EXPECT_GE(got.inliers, 60);
   const Rigid3d error = truth.Inverse() * got.match_from_query;
@@ -104,18 +111,14 @@ TEST(VisualLoops, VerificationRejectsCraftedFalseCandidates) {
   std::mt19937 random(9);
   for (auto& k : scattered.query.keypoints)
     k.uv = Eigen::Vector2f(static_cast<float>(random() % 1200), static_cast<float>(random() % 360));
-  const LoopCandidate a =
-      VerifyVisualCandidate(scattered.query, scattered.match, scattered.query_scan,
-                            scattered.match_scan, c, VisualLoopOptions{});
+  const LoopCandidate a = Verify(scattered, c);
   EXPECT_EQ(a.status, LoopStatus::kFewInliers) << ToString(a.status);
 
   // 2. The images agree (a look-alike facade) but the query's scan is of another place: a long
   // featureless corridor, where the registration cannot confirm the image's pose.
   Pair elsewhere = StreetPair(truth, c);
   elsewhere.query_scan = ScanOf(lidar::testing::CorridorScene(0.1), c);
-  const LoopCandidate b =
-      VerifyVisualCandidate(elsewhere.query, elsewhere.match, elsewhere.query_scan,
-                            elsewhere.match_scan, c, VisualLoopOptions{});
+  const LoopCandidate b = Verify(elsewhere, c);
   EXPECT_GE(b.inliers, 60);  // The images alone would have accepted it.
   EXPECT_NE(b.status, LoopStatus::kAccepted) << ToString(b.status);
 }

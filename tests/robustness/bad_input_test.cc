@@ -570,6 +570,8 @@ TEST_F(BadInputTest, InvalidOptions) {
   ExpectError("loop_detect", loops + " --vocabulary " + Bad("no_vocabulary.h5"),
               "no_vocabulary.h5 not found: give one with --vocabulary");
   ExpectError("loop_detect", loops + " --vocabulary " + In("odom.h5"), "odom.h5");
+  ExpectError("loop_detect", loops + " --visual " + In("odom.h5"),
+              "odom.h5: expected schema 'visual'");
   ExpectError("loop_detect", "-d " + kSeq + " --poses " + Bad("none.h5") + " -o " + Bad("l.h5"),
               "none.h5");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --sequence 1x",

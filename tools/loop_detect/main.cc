@@ -9,10 +9,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "app/option_group.h"
@@ -23,6 +25,7 @@
 #include "io/dataset.h"
 #include "io/loops_io.h"
 #include "io/trajectory_io.h"
+#include "io/visual_io.h"
 #include "loop/lidar_loops.h"
 #include "loop/visual_loops.h"
 #include "loop/vocabulary.h"
@@ -142,7 +145,8 @@ int main(int argc, char** argv) {
                  "visual one by PnP on the LiDAR depth of the earlier image and then the scan "
                  "registration; every verified candidate, accepted or not, goes to the loops "
                  "artifact.");
-  std::string dataset_dir, format = "auto", frames = ":", poses_path, output, gt_path, csv;
+  std::string dataset_dir, format = "auto", frames = ":", poses_path, output, gt_path, csv,
+                           visual_path;
   int every = 5;
   std::vector<std::string> detectors = {"lidar", "visual"};
   std::string vocabulary_path = JVL_DEFAULT_VOCABULARY;
@@ -175,6 +179,11 @@ int main(int argc, char** argv) {
                  "Vocabulary of the visual detector (vocab_train); the default is the one shipped "
                  "in data/vocabulary")
       ->capture_default_str();
+  cli.add_option("--visual", visual_path,
+                 "Visual map of the drive (visual_assoc): the visual detector takes the ORB "
+                 "features of the keyframes it holds from there instead of extracting them again "
+                 "(the same features when visual_assoc ran with the same ORB settings); the "
+                 "others are extracted");
   cli.add_option("--gt", gt_path,
                  "Ground-truth trajectory: report the revisits and the loops' recall and "
                  "precision in the log");
@@ -225,25 +234,75 @@ int main(int argc, char** argv) {
     const Trajectory keyframes = SelectKeyframes(poses, *dataset, every);
     JVL_CHECK(keyframes.size() >= 2,
               poses_path << ": fewer than 2 of its frames are in the dataset");
-    auto load_scan = [&](int64_t f) { return dataset->LoadScan(f); };
+    // One cache of prepared scans for both detectors: the visual one verifies mostly the pairs
+    // the LiDAR one prepared.
+    loop::LoopScanCache scans([&](int64_t f) { return dataset->LoadScan(f); },
+                              dataset->calibration(), options);
+    // The visual map's keypoints of a keyframe: rows [first, last) of keypoints/*.
+    io::VisualMapData map;
+    std::unordered_map<int64_t, std::pair<size_t, size_t>> rows;
+    if (use_visual && !visual_path.empty()) {
+      tool.AddInput(visual_path);
+      map = io::ReadVisualMap(visual_path);
+      JVL_CHECK(std::abs(map.scale_factor - visual_options.orb.scale_factor) < 1e-9 &&
+                    map.num_levels == visual_options.orb.num_levels,
+                visual_path << ": ORB pyramid " << map.num_levels << " levels x "
+                            << map.scale_factor << ", the visual detector uses "
+                            << visual_options.orb.num_levels << " x "
+                            << visual_options.orb.scale_factor);
+      for (size_t p = 0; p < map.num_keypoints(); ++p) {
+        const int64_t f = map.keyframes.frames[static_cast<size_t>(map.keypoint_keyframe[p])];
+        auto [it, added] = rows.emplace(f, std::make_pair(p, p + 1));
+        if (!added) it->second.second = p + 1;
+      }
+      // Only the keypoints are needed.
+      auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
+      release(map.mappoint_position), release(map.mappoint_descriptor);
+      release(map.mappoint_normal), release(map.observation_keyframe);
+      release(map.observation_keypoint), release(map.observation_mappoint);
+      release(map.covisibility_edges), release(map.covisibility_weight);
+    }
     std::vector<loop::LoopCandidate> candidates;
     std::vector<int64_t> lidar_closed;  // Queries the LiDAR detector accepted.
     if (use_lidar) {
       Progress progress("LiDAR keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
-      const loop::LoopResult result =
-          loop::DetectLidarLoops(keyframes, load_scan, dataset->calibration(), options,
-                                 tool.threads(), [&] { progress.Tick(); });
+      const loop::LoopResult result = loop::DetectLidarLoops(
+          keyframes, scans, options, tool.threads(), [&] { progress.Tick(); });
       for (const loop::LoopCandidate& c : result.candidates) {
         candidates.push_back(c);
         if (c.status == loop::LoopStatus::kAccepted) lidar_closed.push_back(c.query);
       }
     }
     if (use_visual) {
+      std::atomic<int64_t> extracted{0};
+      auto features_of = [&](int64_t f) {
+        vision::OrbFeatures out;
+        const auto it = rows.find(f);
+        if (it == rows.end()) {
+          ++extracted;
+          return vision::ExtractOrb(dataset->LoadImage(f, 0), visual_options.orb);
+        }
+        for (size_t p = it->second.first; p < it->second.second; ++p) {
+          vision::OrbKeypoint k;
+          k.uv = Eigen::Vector2f(map.keypoint_uv[2 * p], map.keypoint_uv[2 * p + 1]);
+          k.octave = map.keypoint_octave[p];
+          k.angle = map.keypoint_angle[p];
+          out.keypoints.push_back(k);
+          vision::Descriptor d;
+          std::copy_n(map.keypoint_descriptor.begin() + static_cast<std::ptrdiff_t>(32 * p), 32,
+                      d.begin());
+          out.descriptors.push_back(d);
+        }
+        return out;
+      };
       Progress progress("visual keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
-      const loop::LoopResult result = loop::DetectVisualLoops(
-          keyframes, [&](int64_t f) { return dataset->LoadImage(f, 0); }, load_scan,
-          dataset->calibration(), *vocabulary, visual_options, tool.threads(),
-          [&] { progress.Tick(); });
+      const loop::LoopResult result =
+          loop::DetectVisualLoops(keyframes, features_of, scans, *vocabulary, visual_options,
+                                  tool.threads(), [&] { progress.Tick(); });
+      if (!visual_path.empty())
+        spdlog::info("visual detector: features of {} of {} keyframes from {}, {} extracted",
+                     static_cast<int64_t>(keyframes.size()) - extracted.load(), keyframes.size(),
+                     visual_path, extracted.load());
       for (loop::LoopCandidate c : result.candidates) {
         if (c.status == loop::LoopStatus::kAccepted &&
             std::find(lidar_closed.begin(), lidar_closed.end(), c.query) != lidar_closed.end())
