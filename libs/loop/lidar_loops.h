@@ -53,6 +53,7 @@ struct LidarLoopOptions {
   // The coarse pass registers on the match's surface thinned to one point per voxel of this
   // size (m; 0 = every point): its neighbourhoods are coarse_scale times wider.
   double coarse_voxel = 1.0;
+  int coarse_samples_per_list = 50;  // ... and with fewer samples (of the same lists).
   double max_residual = 0.08;     // m, RMS IMLS distance after registration.
   int min_correspondences = 300;  // At the last iteration.
   double max_translation = 15.0;  // m between the two scans: a revisit, not a place 30 m on.

@@ -20,6 +20,12 @@ TEST(LidarLoops, RejectsBadOptions) {
   o = LidarLoopOptions{};
   o.consistency_deg = 0;
   EXPECT_THROW(o.Check(), std::exception);
+  o = LidarLoopOptions{};
+  o.coarse_samples_per_list = o.association.samples_per_list + 1;
+  EXPECT_THROW(o.Check(), std::exception);
+  o = LidarLoopOptions{};
+  o.coarse_voxel = -1;
+  EXPECT_THROW(o.Check(), std::exception);
 }
 
 Rigid3d Pose(double yaw, double x, double z) {

@@ -306,7 +306,10 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
   // Verification (independent, in parallel; results in their slots), then the best accepted
   // candidate per query (most inliers), or the first rejected one.
   std::vector<LoopCandidate> verified(to_verify.size());
-  ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t v) {
+  // Latest queries first: the LiDAR detector, verifying in query order, left the scans of its
+  // latest queries and their matches in the shared cache.
+  ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t r) {
+    const int64_t v = static_cast<int64_t>(to_verify.size()) - 1 - r;
     const auto [q, m] = to_verify[static_cast<size_t>(v)];
     LoopCandidate c = VerifyVisualCandidate(described[q], described[m], keyframes.frames[q],
                                             keyframes.frames[m], scans, scans.calibration(), o);
