@@ -26,10 +26,9 @@ void LidarLoopOptions::Check() const {
   JVL_CHECK(max_descriptor_distance > 0 && max_descriptor_distance <= 1,
             "max_descriptor_distance must be in (0, 1], got " << max_descriptor_distance);
   JVL_CHECK(coarse_scale >= 1, "coarse_scale must be >= 1, got " << coarse_scale);
-  JVL_CHECK(coarse_samples_per_list >= 1 &&
-                coarse_samples_per_list <= association.samples_per_list,
-            "coarse_samples_per_list must be in [1, samples_per_list], got "
-                << coarse_samples_per_list);
+  JVL_CHECK(
+      coarse_samples_per_list >= 1 && coarse_samples_per_list <= association.samples_per_list,
+      "coarse_samples_per_list must be in [1, samples_per_list], got " << coarse_samples_per_list);
   JVL_CHECK(std::isfinite(coarse_voxel) && coarse_voxel >= 0,
             "coarse_voxel must be >= 0, got " << coarse_voxel);
   JVL_CHECK(max_residual > 0, "max_residual must be > 0, got " << max_residual);

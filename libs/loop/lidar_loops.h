@@ -54,9 +54,9 @@ struct LidarLoopOptions {
   // size (m; 0 = every point): its neighbourhoods are coarse_scale times wider.
   double coarse_voxel = 1.0;
   int coarse_samples_per_list = 50;  // ... and with fewer samples (of the same lists).
-  double max_residual = 0.08;     // m, RMS IMLS distance after registration.
-  int min_correspondences = 300;  // At the last iteration.
-  double max_translation = 15.0;  // m between the two scans: a revisit, not a place 30 m on.
+  double max_residual = 0.08;        // m, RMS IMLS distance after registration.
+  int min_correspondences = 300;     // At the last iteration.
+  double max_translation = 15.0;     // m between the two scans: a revisit, not a place 30 m on.
   // The trajectory given (a prior or odometry) may drift, but not without bound: the two
   // keyframes must lie within max_prior_offset + max_prior_drift x (path length between them)
   // of each other in it. Rejects a look-alike place far away (repetitive streets).
