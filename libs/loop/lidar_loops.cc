@@ -84,15 +84,7 @@ lidar::ScanSurface PreparedSurface(const PointCloud& scan, const Calibration& ca
 LoopScan::LoopScan(const PointCloud& scan, const Calibration& calibration,
                    const LidarLoopOptions& o)
     : samples(lidar::SampleSurface(PreparedSurface(scan, calibration, o),
-                                   o.association.samples_per_list)),
-      model(o.association.search_radius),
-      coarse_model(o.association.search_radius * o.coarse_scale) {
-  lidar::AddScanToModel(samples.points, samples.normals, Rigid3d(), 0, &model);
-  if (o.coarse_scale > 1) {
-    const lidar::StoredScan thinned = lidar::StoreScan(samples, o.coarse_voxel);
-    lidar::AddScanToModel(thinned.points, thinned.normals, Rigid3d(), 0, &coarse_model);
-  }
-}
+                                   o.association.samples_per_list)) {}
 
 lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopScan& match,
                                             const Rigid3d& initial, const LidarLoopOptions& o) {
@@ -105,7 +97,12 @@ lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopSca
   JVL_CHECK(!initials.empty(), "RegisterLoopScans needs a start");
   size_t best = 0;
   Rigid3d start = initials[0];
+  // The match's surface as IMLS models (built here: a millisecond, where keeping them would
+  // double a prepared scan's memory).
   if (o.coarse_scale > 1) {
+    lidar::ImlsModel coarse_model(o.association.search_radius * o.coarse_scale);
+    const lidar::StoredScan thinned = lidar::StoreScan(match.samples, o.coarse_voxel);
+    lidar::AddScanToModel(thinned.points, thinned.normals, Rigid3d(), 0, &coarse_model);
     lidar::AssociationOptions coarse = o.association;
     lidar::RegistrationOptions coarse_registration = o.registration;
     lidar::ScaleNeighbourhoods(o.coarse_scale, &coarse, &coarse_registration);
@@ -118,7 +115,7 @@ lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopSca
     std::optional<lidar::RegistrationResult> kept;
     for (size_t i = 0; i < initials.size(); ++i) {
       const lidar::RegistrationResult first = lidar::RegisterSampled(
-          query.samples, match.coarse_model, initials[i], coarse, coarse_registration, 1);
+          query.samples, coarse_model, initials[i], coarse, coarse_registration, 1);
       if (!kept || rank(first) < rank(*kept)) {
         kept = first;
         best = i;
@@ -127,8 +124,9 @@ lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopSca
     }
   }
   if (chosen) *chosen = best;
-  return lidar::RegisterSampled(query.samples, match.model, start, o.association, o.registration,
-                                1);
+  lidar::ImlsModel model(o.association.search_radius);
+  lidar::AddScanToModel(match.samples.points, match.samples.normals, Rigid3d(), 0, &model);
+  return lidar::RegisterSampled(query.samples, model, start, o.association, o.registration, 1);
 }
 
 LoopScanCache::LoopScanCache(std::function<PointCloud(int64_t)> load_scan,

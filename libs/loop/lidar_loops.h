@@ -129,12 +129,11 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
                             const std::function<void()>& tick = nullptr);
 
 // The verification shared by both detectors. A keyframe's scan preprocessed as lidar_odom does
-// it (cam0 frame) and its surface, as IMLS-SLAM sampling lists (registered as the query) and as
-// IMLS models at the normal and the coarse neighbourhoods (registered on) ...
+// it (cam0 frame) and its surface, as IMLS-SLAM sampling lists: the points registered as the
+// query, and the points of the IMLS models registered on ...
 struct LoopScan {
   LoopScan(const PointCloud& scan, const Calibration& calibration, const LidarLoopOptions& options);
   lidar::SampledScan samples;
-  lidar::ImlsModel model, coarse_model;
 };
 // ... `query` registered on `match` from `initial` = match_from_query: a coarse pass with
 // scaled neighbourhoods, then the normal one (as lidar_odom's first pair) ...
@@ -167,12 +166,12 @@ bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, si
 
 // The prepared scans of the keyframes being verified, each prepared once and kept while it is
 // among the `capacity` most recently used (consecutive queries verify against neighbouring
-// matches; about 2 MB each on KITTI scans). Both detectors may share one. Thread-safe; a scan
+// matches; about 1 MB each on KITTI scans). Both detectors may share one. Thread-safe; a scan
 // is prepared outside the cache's lock, once.
 class LoopScanCache {
  public:
   LoopScanCache(std::function<PointCloud(int64_t)> load_scan, const Calibration& calibration,
-                const LidarLoopOptions& options, size_t capacity = 256);
+                const LidarLoopOptions& options, size_t capacity = 1024);
   std::shared_ptr<const LoopScan> Get(int64_t frame);
   PointCloud Load(int64_t frame) const { return load_scan_(frame); }  // As read, not cached.
   const LidarLoopOptions& options() const { return options_; }        // The preparation's.

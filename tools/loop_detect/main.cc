@@ -148,6 +148,7 @@ int main(int argc, char** argv) {
   std::string dataset_dir, format = "auto", frames = ":", poses_path, output, gt_path, csv,
                            visual_path;
   int every = 5;
+  int scan_cache = 1024;
   std::vector<std::string> detectors = {"lidar", "visual"};
   std::string vocabulary_path = JVL_DEFAULT_VOCABULARY;
   loop::LidarLoopOptions options;
@@ -184,6 +185,11 @@ int main(int argc, char** argv) {
                  "features of the keyframes it holds from there instead of extracting them again "
                  "(the same features when visual_assoc ran with the same ORB settings); the "
                  "others are extracted");
+  cli.add_option("--scan-cache", scan_cache,
+                 "Prepared scans kept for the verification (about 1 MB each on KITTI scans): more "
+                 "saves preparing a scan again when matches lie several laps back")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cli.add_option("--gt", gt_path,
                  "Ground-truth trajectory: report the revisits and the loops' recall and "
                  "precision in the log");
@@ -237,7 +243,7 @@ int main(int argc, char** argv) {
     // One cache of prepared scans for both detectors: the visual one verifies mostly the pairs
     // the LiDAR one prepared.
     loop::LoopScanCache scans([&](int64_t f) { return dataset->LoadScan(f); },
-                              dataset->calibration(), options);
+                              dataset->calibration(), options, static_cast<size_t>(scan_cache));
     // The visual map's keypoints of a keyframe: rows [first, last) of keypoints/*.
     io::VisualMapData map;
     std::unordered_map<int64_t, std::pair<size_t, size_t>> rows;
