@@ -142,7 +142,7 @@ lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopSca
                                             const LidarLoopOptions& options);
 // ... or from the best of several starts: each registered at the coarse neighbourhoods, the
 // best one (converged without a degenerate direction, then the lower residual; its index in
-// *chosen) refined.
+// *chosen) refined; without a coarse pass (coarse_scale 1) the first start.
 lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopScan& match,
                                             const std::vector<Rigid3d>& initials,
                                             const LidarLoopOptions& options,
