@@ -129,7 +129,8 @@ double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoop
 
 LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
                                     int64_t query_frame, int64_t match_frame, LoopScanCache& scans,
-                                    const Calibration& calibration, const VisualLoopOptions& o) {
+                                    const VisualLoopOptions& o) {
+  const Calibration& calibration = scans.calibration();
   LoopCandidate c;
   c.detector = "visual";
   c.status = LoopStatus::kFewInliers;
@@ -312,7 +313,7 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
     const int64_t v = static_cast<int64_t>(to_verify.size()) - 1 - r;
     const auto [q, m] = to_verify[static_cast<size_t>(v)];
     LoopCandidate c = VerifyVisualCandidate(described[q], described[m], keyframes.frames[q],
-                                            keyframes.frames[m], scans, scans.calibration(), o);
+                                            keyframes.frames[m], scans, o);
     c.query = keyframes.frames[q];
     c.match = keyframes.frames[m];
     c.descriptor_distance = to_verify_score[static_cast<size_t>(v)];

@@ -94,7 +94,6 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
 // only when the images agree on a pose).
 LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
                                     int64_t query_frame, int64_t match_frame, LoopScanCache& scans,
-                                    const Calibration& calibration,
                                     const VisualLoopOptions& options);
 
 }  // namespace jvl::loop

@@ -42,7 +42,7 @@ LoopCandidate Verify(const Pair& p, const Calibration& c) {
   const VisualLoopOptions o;
   LoopScanCache scans([&](int64_t frame) { return frame == 1 ? p.query_scan : p.match_scan; }, c,
                       o.lidar);
-  return VerifyVisualCandidate(p.query, p.match, 1, 0, scans, c, o);
+  return VerifyVisualCandidate(p.query, p.match, 1, 0, scans, o);
 }
 
 // A street seen by the match keyframe at the origin and by the query from `match_from_query`;
