@@ -163,7 +163,7 @@ cv::Mat LoadImageChecked(const std::string& path, int64_t frame, int camera,
                          const Calibration& calibration, const std::string& size_source) {
   JVL_CHECK(FileExists(path),
             path << ": missing image of camera " << camera << " for frame " << frame);
-  cv::Mat image = ReadImage(path, camera < 2);
+  cv::Mat image = ReadImage(path, /*grayscale=*/true);
   JVL_CHECK(image.cols >= kMinImageSide && image.rows >= kMinImageSide,
             path << ": image is " << image.cols << "x" << image.rows << ", too small (at least "
                  << kMinImageSide << "x" << kMinImageSide << ")");
@@ -204,7 +204,10 @@ class KittiOdometryDataset : public Dataset {
     const fs::path p(dir);
     calibration_ = ReadKittiCalibration((p / "calib.txt").string());
     const auto scans = ListNumberedFiles((p / "velodyne").string(), ".bin");
-    const auto images = ListNumberedFiles((p / "image_0").string(), ".png");
+    // The images of camera 0, or of the first other camera stored (a colour-only download).
+    std::map<int64_t, std::string> images;
+    for (int c = 0; c < 4 && images.empty(); ++c)
+      images = ListNumberedFiles((p / ("image_" + std::to_string(c))).string(), ".png");
     const std::vector<int64_t> all = DatasetFrames(FrameIds(scans), FrameIds(images), dir);
     SelectFrames(all, range, dir, &frames_);
 
@@ -273,6 +276,17 @@ class KittiOdometryDataset : public Dataset {
 };
 
 }  // namespace
+
+void Dataset::CheckCamera(int camera) const {
+  JVL_CHECK(camera >= 0 && camera < 4, "--camera " << camera << " is not a camera (0..3)");
+  JVL_CHECK(format_ != DatasetFormat::kKitti360 || camera < 2,
+            root_ << ": KITTI-360 camera " << camera
+                  << " is a fisheye camera; the tools read the perspective cameras 0 and 1");
+  JVL_CHECK(
+      format_ != DatasetFormat::kOxford || camera == 0,
+      root_ << ": camera " << camera << " is not read; camera 0 is the stereo rig's centre camera");
+  calibration_.CheckCamera(camera, root_);
+}
 
 std::vector<std::string> Dataset::InputFiles() const {
   std::vector<std::string> files = KeyFiles();

@@ -22,6 +22,10 @@ enum class DatasetFormat { kAuto, kKittiOdometry, kKittiRaw, kKitti360, kOxford 
 DatasetFormat ParseDatasetFormat(const std::string& name);  // auto|kitti|kitti-raw|kitti360|oxford
 const char* DatasetFormatName(DatasetFormat format);        // the name ParseDatasetFormat takes
 // Help text of the tools' --format option.
+inline constexpr const char* kCameraHelp =
+    "Camera whose images are used: 0 (left grey, the default), 1, 2 (left colour) or 3; colour "
+    "is converted to grey. Poses stay world_from_cam0: the camera's offset from camera 0 comes "
+    "from the calibration (P_rect) and is recorded in the artifact";
 inline constexpr const char* kDatasetFormatHelp =
     "Dataset layout: auto (detected from the folder), kitti, kitti-raw, kitti360 or oxford";
 
@@ -49,8 +53,12 @@ class Dataset {
   // LiDAR scan of `frame` in the velodyne frame. Non-finite points are dropped and counted in
   // *dropped (a warning is logged). Throws naming the file on a missing or malformed scan.
   virtual PointCloud LoadScan(int64_t frame, size_t* dropped = nullptr) const = 0;
-  // Image of camera `camera` (0/1 greyscale, 2/3 colour as stored). Throws naming the file.
+  // Grey image of camera `camera` (colour cameras converted, 0.299 R + 0.587 G + 0.114 B).
+  // Throws naming the file.
   virtual cv::Mat LoadImage(int64_t frame, int camera = 0) const = 0;
+  // Throws a one-line error unless the image stages can use camera `camera` of this dataset
+  // (its projection is known and the layout stores its images rectified).
+  void CheckCamera(int camera) const;
   virtual std::string ScanPath(int64_t frame) const = 0;
   virtual std::string ImagePath(int64_t frame, int camera = 0) const = 0;
   // Key files that identify the content (calibration, times) for provenance.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 
 #include "core/check.h"
 #include "io/files.h"
@@ -123,6 +124,33 @@ TEST_F(BadDatasetTest, ReadsTheGoodFolder) {
   EXPECT_EQ(c.points[1], Eigen::Vector3d(4, 5, 6));
   EXPECT_FLOAT_EQ(c.intensity[0], 0.5f);
   EXPECT_FALSE(ds->ground_truth().has_value());
+}
+
+// A colour-only download (image_2 and image_3, no image_0): the image size comes from camera
+// 2's images, colour is converted to grey (OpenCV's 0.299 R + 0.587 G + 0.114 B), and cameras
+// without images or projection are refused in one line.
+TEST_F(BadDatasetTest, ColourCameraImagesAreReadAsGrey) {
+  fs::create_directories(seq_ / "image_2");
+  cv::Mat colour(80, 96, CV_8UC3, cv::Scalar(0, 0, 0));
+  colour(cv::Rect(0, 0, 48, 80)).setTo(cv::Scalar(255, 0, 0));   // blue (BGR)
+  colour(cv::Rect(48, 0, 48, 80)).setTo(cv::Scalar(0, 0, 200));  // red
+  for (int f = 0; f < 3; ++f) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "%06d.png", f);
+    cv::imwrite((seq_ / "image_2" / name).string(), colour);
+  }
+  const auto ds = OpenDataset(seq_.string());
+  EXPECT_EQ(ds->calibration().image_width, 96);
+  EXPECT_EQ(ds->calibration().image_height, 80);
+  EXPECT_NO_THROW(ds->CheckCamera(2));
+  const cv::Mat grey = ds->LoadImage(1, 2);
+  ASSERT_EQ(grey.type(), CV_8UC1);
+  EXPECT_NEAR(grey.at<uint8_t>(10, 10), 0.114 * 255, 1.0);
+  EXPECT_NEAR(grey.at<uint8_t>(10, 60), 0.299 * 200, 1.0);
+  EXPECT_NE(ErrorOf([&] { ds->LoadImage(1, 0); }).find("missing image of camera 0 for frame 1"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ds->CheckCamera(5); }).find("--camera 5 is not a camera"),
+            std::string::npos);
 }
 
 // KITTI odometry scans are motion-compensated; a sim_sequence folder says in sim/scene.json.

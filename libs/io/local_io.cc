@@ -52,6 +52,7 @@ void WriteLocalMap(const std::string& path, const LocalMapData& d, const Provena
   const int64_t s = static_cast<int64_t>(d.num_scan_points());
   H5Writer w(path, kLocalSchema, kLocalSchemaVersion);
   WriteCameraArray(w, "camera", d.camera);
+  WriteCameraChoice(w, d.camera_choice);
   WriteTrajectoryGroup(w, "keyframes", d.keyframes);
   w.WriteArray("imls/n", d.imls_n);
   w.WriteArray("imls/c", d.imls_c);
@@ -78,6 +79,7 @@ LocalMapData ReadLocalMap(const std::string& path, LocalMapParts parts) {
   H5Reader r(path, kLocalSchema, kLocalSchemaVersion);
   LocalMapData d;
   d.camera = ReadCameraArray(r, "camera");
+  d.camera_choice = ReadCameraChoice(r);
   d.keyframes = ReadTrajectoryGroup(r, "keyframes");
   if (parts == LocalMapParts::kAll) {
     d.imls_n = r.ReadArray<int32_t>("imls/n");

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/calibration.h"
 #include "geometry/camera.h"
 #include "geometry/trajectory.h"
 #include "io/artifact.h"
@@ -32,7 +33,8 @@ inline constexpr int kLocalSchemaVersion = 1;
 // Flat arrays laid out exactly as in the file (row-major).
 struct LocalMapData {
   PinholeCamera camera;
-  Trajectory keyframes;  // Refined world_from_cam0 of each keyframe.
+  CameraChoice camera_choice;  // camera_index / camera_offset (camera 0 when absent)
+  Trajectory keyframes;        // Refined world_from_cam0 of each keyframe.
   std::vector<int32_t> imls_n, imls_c;
   std::vector<double> imls_p_x, imls_p_y, imls_normal;  // L x 3 each.
   std::vector<double> mappoint_position;                // M x 3.

@@ -55,14 +55,18 @@ std::string SequenceLayout::ScanPath(int64_t f) const {
     return SequenceDir() + "/velodyne_points/data/" + ZeroPaddedName(f, 10, ".bin");
   return SequenceDir() + "/velodyne/" + ZeroPaddedName(f, 6, ".bin");
 }
-std::string SequenceLayout::ImagePath(int64_t f) const {
+std::string SequenceLayout::ImagePath(int64_t f, int camera) const {
+  JVL_CHECK(camera >= 0 && camera < 4, "camera " << camera << " is not a camera (0..3)");
+  JVL_CHECK(camera == 0 || layout == SimLayout::kKitti,
+            "the " << (layout == SimLayout::kOxford ? "Oxford" : "KITTI-360")
+                   << " layout is written with camera 0 only, not camera " << camera);
   if (layout == SimLayout::kOxford)
     return SequenceDir() + "/stereo/centre/" + std::to_string(OxfordTime(f)) + ".png";
   if (layout == SimLayout::kKitti360) {
     return root + "/data_2d_raw/" + Drive() + "/image_00/data_rect/" +
            ZeroPaddedName(f, 10, ".png");
   }
-  return SequenceDir() + "/image_0/" + ZeroPaddedName(f, 6, ".png");
+  return SequenceDir() + "/image_" + std::to_string(camera) + "/" + ZeroPaddedName(f, 6, ".png");
 }
 std::string SequenceLayout::PosesPath() const {
   if (layout == SimLayout::kOxford) return SequenceDir() + "/gps/ins.csv";

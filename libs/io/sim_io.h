@@ -38,12 +38,13 @@ struct SequenceLayout {
       : root(std::move(root_dir)), sequence(std::move(sequence_name)), layout(kind) {}
   std::string root, sequence;
   SimLayout layout = SimLayout::kKitti;
-  std::vector<double> times;                   // frame timestamps (s); Oxford only
-  int64_t OxfordTime(int64_t frame) const;     // µs since 1970
-  std::string Drive() const;                   // KITTI-360 drive / Oxford traversal folder name
-  std::string SequenceDir() const;             // what the tools' --dataset takes
-  std::string ScanPath(int64_t frame) const;   // velodyne/000000.bin, .../data/0000000000.bin
-  std::string ImagePath(int64_t frame) const;  // image_0/000000.png, .../data_rect/0000000000.png
+  std::vector<double> times;                  // frame timestamps (s); Oxford only
+  int64_t OxfordTime(int64_t frame) const;    // µs since 1970
+  std::string Drive() const;                  // KITTI-360 drive / Oxford traversal folder name
+  std::string SequenceDir() const;            // what the tools' --dataset takes
+  std::string ScanPath(int64_t frame) const;  // velodyne/000000.bin, .../data/0000000000.bin
+  // image_<camera>/000000.png, .../data_rect/0000000000.png (KITTI-360 and Oxford: camera 0).
+  std::string ImagePath(int64_t frame, int camera = 0) const;
   std::string PosesPath() const;  // ROOT/poses/NN.txt, data_poses/DRIVE/cam0_to_world.txt
   std::string SimDir() const;     // SequenceDir()/sim
 };

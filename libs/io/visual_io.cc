@@ -96,6 +96,7 @@ void WriteVisualMap(const std::string& path, const VisualMapData& d, const Prove
   const int64_t m = static_cast<int64_t>(d.num_mappoints());
   H5Writer w(path, kVisualSchema, kVisualSchemaVersion);
   WriteCameraArray(w, "camera", d.camera);
+  WriteCameraChoice(w, d.camera_choice);
   w.WriteJson("orb", {{"scale_factor", d.scale_factor}, {"num_levels", d.num_levels}});
   WriteTrajectoryGroup(w, "keyframes", d.keyframes);
   w.WriteArray("keypoints/keyframe", d.keypoint_keyframe);
@@ -121,6 +122,7 @@ VisualMapData ReadVisualMap(const std::string& path) {
   H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
   VisualMapData d;
   d.camera = ReadCameraArray(r, "camera");
+  d.camera_choice = ReadCameraChoice(r);
   const nlohmann::json orb = r.ReadJson("orb");
   JVL_CHECK(orb.is_object() && orb.contains("scale_factor") && orb["scale_factor"].is_number() &&
                 orb.contains("num_levels") && orb["num_levels"].is_number_integer(),

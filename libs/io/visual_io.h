@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/calibration.h"
 #include "geometry/camera.h"
 #include "geometry/trajectory.h"
 #include "io/artifact.h"
@@ -30,7 +31,8 @@ inline constexpr int kVisualSchemaVersion = 1;
 // Flat arrays laid out exactly as in the file (row-major).
 struct VisualMapData {
   PinholeCamera camera;
-  double scale_factor = 1.2;  // ORB pyramid: keypoint sigma = scale_factor^octave px.
+  CameraChoice camera_choice;  // camera_index / camera_offset (camera 0 when absent)
+  double scale_factor = 1.2;   // ORB pyramid: keypoint sigma = scale_factor^octave px.
   int num_levels = 8;
   Trajectory keyframes;  // Keyframe frame ids and their prior world_from_cam0 poses.
   std::vector<int32_t> keypoint_keyframe;
@@ -65,6 +67,5 @@ void WarnIfCovisibilitySplit(const VisualMapData& data, const std::string& path)
 void WriteVisualMap(const std::string& path, const VisualMapData& data,
                     const Provenance& provenance);
 VisualMapData ReadVisualMap(const std::string& path);
-
 
 }  // namespace jvl::io

@@ -1,5 +1,4 @@
 #include "io/visual_io.h"
-#include "io/schema_check.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -9,6 +8,7 @@
 #include <map>
 
 #include "core/check.h"
+#include "io/schema_check.h"
 
 namespace jvl::io {
 namespace {
@@ -75,6 +75,24 @@ TEST(VisualIo, RoundTrip) {
   EXPECT_EQ(r.scale_factor, 1.2);
   EXPECT_EQ(r.num_levels, 8);
   EXPECT_EQ(r.summary.at("keyframes").get<int>(), 2);
+  fs::remove(path);
+}
+
+// The camera choice of a map built from another camera is kept; a camera-0 map has none written.
+TEST(VisualIo, CameraChoiceRoundTrip) {
+  const std::string path = TempPath("cam.h5").string();
+  WriteVisualMap(path, MakeMap(), Provenance{});
+  EXPECT_FALSE(H5Reader(path, kVisualSchema, kVisualSchemaVersion).Has("camera_index"));
+  EXPECT_EQ(ReadVisualMap(path).camera_choice.index, 0);
+  VisualMapData d = MakeMap();
+  d.camera_choice = {2, Eigen::Vector3d(0.061, -0.0003, 0.0062)};
+  WriteVisualMap(path, d, Provenance{});
+  const VisualMapData r = ReadVisualMap(path);
+  EXPECT_EQ(r.camera_choice.index, 2);
+  EXPECT_EQ(r.camera_choice.offset, d.camera_choice.offset);
+  const auto problems =
+      CheckH5AgainstSchema(path, std::string(JVL_SOURCE_DIR) + "/schemas/visual.schema.json");
+  EXPECT_TRUE(problems.empty()) << problems.front();
   fs::remove(path);
 }
 

@@ -14,6 +14,7 @@ void WriteVps(H5Writer& writer, const VpsData& data) {
   const int64_t m = static_cast<int64_t>(data.vps.size());
   writer.WriteArray("frames", data.frames);
   WriteCameraArray(writer, "camera", data.camera);
+  WriteCameraChoice(writer, data.camera_choice);
   std::vector<int64_t> frame;
   std::vector<int32_t> index, inliers;
   std::vector<double> uv, direction, residual, score;
@@ -49,6 +50,7 @@ VpsData ReadVpsArtifact(const std::string& path) {
   VpsData data;
   data.frames = reader.ReadArray<int64_t>("frames");
   data.camera = ReadCameraArray(reader, "camera");
+  data.camera_choice = ReadCameraChoice(reader);
   const auto frame = reader.ReadArray<int64_t>("vps/frame");
   const auto index = reader.ReadArray<int32_t>("vps/index");
   const auto uv = reader.ReadArray<double>("vps/uv", 2);

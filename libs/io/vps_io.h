@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/calibration.h"
 #include "geometry/camera.h"
 #include "io/artifact.h"
 
@@ -30,7 +31,8 @@ struct VpRecord {
 struct VpsData {
   std::vector<int64_t> frames;  // Every processed frame, also those without VPs.
   PinholeCamera camera;
-  std::vector<VpRecord> vps;  // Grouped by frame in the order of `frames`.
+  CameraChoice camera_choice;  // camera_index / camera_offset (camera 0 when absent)
+  std::vector<VpRecord> vps;   // Grouped by frame in the order of `frames`.
 };
 
 // Writes the datasets into an open writer (schema "vps" v1).

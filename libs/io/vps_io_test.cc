@@ -90,31 +90,43 @@ TEST(VpsIo, MatchesSchemaFile) {
   const auto schema =
       nlohmann::json::parse(ReadTextFile(std::string(JVL_SOURCE_DIR) + "/schemas/vps.schema.json"));
   const std::string path = TempPath("schema.h5");
-  WriteVpsArtifact(path, Sample(), Provenance{});
-  H5Reader reader(path, "vps", 1);
-  EXPECT_EQ(schema["properties"]["schema"]["const"], reader.schema());
-  EXPECT_EQ(schema["properties"]["schema_version"]["const"], reader.schema_version());
-  std::map<std::string, int64_t> symbols;
-  int datasets = 0;
-  for (const auto& [name, prop] : schema["properties"].items()) {
-    if (!prop.contains("x-hdf5")) continue;
-    ++datasets;
-    ASSERT_TRUE(reader.Has(name)) << name;
-    const std::vector<int64_t> dims = reader.Dims(name);
-    const auto& shape = prop["x-hdf5"]["shape"];
-    ASSERT_EQ(dims.size(), shape.size()) << name;
-    for (size_t k = 0; k < dims.size(); ++k) {
-      if (shape[k].is_number()) {
-        EXPECT_EQ(dims[k], shape[k].get<int64_t>()) << name;
-      } else {
-        const auto [it, fresh] = symbols.emplace(shape[k].get<std::string>(), dims[k]);
-        EXPECT_EQ(it->second, dims[k]) << name << " dim " << k;
+  // Camera 2's artifact also has the optional camera_index and camera_offset.
+  for (const int camera : {0, 2}) {
+    VpsData sample = Sample();
+    if (camera == 2) sample.camera_choice = {2, Eigen::Vector3d(0.06, 0, 0.006)};
+    WriteVpsArtifact(path, sample, Provenance{});
+    H5Reader reader(path, "vps", 1);
+    EXPECT_EQ(ReadVpsArtifact(path).camera_choice.index, camera);
+    EXPECT_EQ(schema["properties"]["schema"]["const"], reader.schema());
+    EXPECT_EQ(schema["properties"]["schema_version"]["const"], reader.schema_version());
+    std::map<std::string, int64_t> symbols;
+    int datasets = 0;
+    for (const auto& [name, prop] : schema["properties"].items()) {
+      if (!prop.contains("x-hdf5")) continue;
+      const auto& required = schema["required"];
+      if (std::find(required.begin(), required.end(), name) == required.end() &&
+          !reader.Has(name)) {
+        EXPECT_EQ(camera, 0) << name;
+        continue;
+      }
+      ++datasets;
+      ASSERT_TRUE(reader.Has(name)) << name;
+      const std::vector<int64_t> dims = reader.Dims(name);
+      const auto& shape = prop["x-hdf5"]["shape"];
+      ASSERT_EQ(dims.size(), shape.size()) << name;
+      for (size_t k = 0; k < dims.size(); ++k) {
+        if (shape[k].is_number()) {
+          EXPECT_EQ(dims[k], shape[k].get<int64_t>()) << name;
+        } else {
+          const auto [it, fresh] = symbols.emplace(shape[k].get<std::string>(), dims[k]);
+          EXPECT_EQ(it->second, dims[k]) << name << " dim " << k;
+        }
       }
     }
+    EXPECT_EQ(datasets, camera == 0 ? 10 : 12);
+    EXPECT_EQ(symbols["F"], 3);
+    EXPECT_EQ(symbols["M"], 3);
   }
-  EXPECT_EQ(datasets, 10);
-  EXPECT_EQ(symbols["F"], 3);
-  EXPECT_EQ(symbols["M"], 3);
   std::filesystem::remove(path);
 }
 

@@ -15,6 +15,7 @@ namespace jvl::loop {
 void VisualLoopOptions::Check() const {
   orb.Check();
   lidar.Check();
+  JVL_CHECK(camera >= 0 && camera < 4, "--camera " << camera << " is not a camera (0..3)");
   JVL_CHECK(std::isfinite(min_separation_m) && min_separation_m >= 0,
             "min_separation_m must be >= 0, got " << min_separation_m);
   JVL_CHECK(group_keyframes >= 0, "group_keyframes must be >= 0, got " << group_keyframes);
@@ -91,12 +92,12 @@ std::vector<std::pair<int, int>> MatchByNode(const VisualKeyframe& q, const Visu
   return pairs;
 }
 
-// Depth image of a scan in camera 0: the nearest return per pixel (0 where none).
+// Depth image of a scan in the chosen camera: the nearest return per pixel (0 where none).
 cv::Mat ScanDepth(const PointCloud& scan, const Calibration& calibration,
-                  const PinholeCamera& camera) {
+                  const PinholeCamera& camera, const Eigen::Vector3d& camera_offset) {
   cv::Mat depth(camera.height, camera.width, CV_32F, cv::Scalar(0));
   for (const Eigen::Vector3d& p : scan.points) {
-    const Eigen::Vector3d c = calibration.cam0_from_velo * p;
+    const Eigen::Vector3d c = calibration.cam0_from_velo * p + camera_offset;
     if (c.z() < 0.5) continue;
     const Eigen::Vector2d uv = camera.Project(c);
     if (!camera.InImage(uv)) continue;
@@ -134,8 +135,10 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
   LoopCandidate c;
   c.detector = "visual";
   c.status = LoopStatus::kFewInliers;
-  const PinholeCamera camera = calibration.Camera(0);
-  const cv::Mat depth = ScanDepth(scans.Load(match_frame), calibration, camera);
+  // Geometry in the chosen camera's frame; the points and poses returned are in camera 0's.
+  const PinholeCamera camera = calibration.Camera(o.camera);
+  const CameraChoice choice = CameraChoice::Of(calibration, o.camera);
+  const cv::Mat depth = ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   std::vector<LoopPoint> points;
@@ -145,12 +148,13 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
     const double z = DepthAt(depth, km.uv, o);
     if (z <= 0) continue;
     LoopPoint point;
-    point.p_match = z * camera.Unproject(km.uv.cast<double>());
+    const Eigen::Vector3d p_camera = z * camera.Unproject(km.uv.cast<double>());
+    point.p_match = p_camera - choice.offset;
     point.match_uv = km.uv.cast<double>();
     point.query_uv = kq.uv.cast<double>();
     point.match_octave = km.octave;
     point.query_octave = kq.octave;
-    object.emplace_back(point.p_match.x(), point.p_match.y(), point.p_match.z());
+    object.emplace_back(p_camera.x(), p_camera.y(), p_camera.z());
     image.emplace_back(point.query_uv.x(), point.query_uv.y());
     points.push_back(point);
   }
@@ -174,7 +178,9 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
   cv::cv2eigen(r, rotation);
   cv::cv2eigen(tvec, translation);
   const Rigid3d image_pose =
-      Rigid3d(Eigen::Quaterniond(rotation).normalized(), translation).Inverse();
+      choice.camera_from_cam0().Inverse() *
+      Rigid3d(Eigen::Quaterniond(rotation).normalized(), translation).Inverse() *
+      choice.camera_from_cam0();
 
   const lidar::RegistrationResult reg =
       RegisterLoopScans(*scans.Get(query_frame), *scans.Get(match_frame), image_pose, o.lidar);
@@ -197,7 +203,7 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
   const std::vector<double> scales = vision::LevelScales(o.orb);
   std::vector<LoopPoint> kept;
   for (const LoopPoint& p : c.points) {
-    const Eigen::Vector3d x = query_from_match * p.p_match;
+    const Eigen::Vector3d x = query_from_match * p.p_match + choice.offset;
     const double sigma = scales[static_cast<size_t>(
         std::clamp(p.query_octave, 0, static_cast<int>(scales.size()) - 1))];
     if (x.z() > 0 && (camera.Project(x) - p.query_uv).norm() <= o.point_max_error_sigmas * sigma)

@@ -33,6 +33,7 @@ namespace jvl::loop {
 
 struct VisualLoopOptions {
   vision::OrbOptions orb;          // Features of each keyframe image.
+  int camera = 0;                  // The camera of the images (loop_detect --camera).
   double min_separation_m = 50.0;  // Candidates at least this far back along the path (m).
   int group_keyframes = 2;         // Neighbours either side: a candidate's group; the query's.
   double min_common_ratio = 0.8;   // Of the largest number of words shared with the query.

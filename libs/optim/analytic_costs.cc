@@ -38,8 +38,9 @@ Eigen::Matrix<double, 3, 4> InverseRotateJacobian(const double* q_xyzw, const Ei
   return RotateJacobianSigned(q_xyzw, v, -1.0);
 }
 
-// x_c = R_wc^T (X - t_wc), r = s (uv - pi(x_c)). dr/dx_c = -s [fx/z 0 -fx x/z^2; 0 fy/z -fy y/z^2];
-// dx_c/dq = d(R^T d)/dq with d = X - t_wc, dx_c/dt_wc = -R_wc^T, dx_c/dX = R_wc^T.
+// x_c = R_wc^T (X - t_wc) + o, r = s (uv - pi(x_c)). dr/dx_c = -s [fx/z 0 -fx x/z^2; 0 fy/z
+// -fy y/z^2]; dx_c/dq = d(R^T d)/dq with d = X - t_wc, dx_c/dt_wc = -R_wc^T, dx_c/dX = R_wc^T (the
+// constant offset o of the observing camera does not enter the derivatives of x_c).
 bool VisualReprojectionAnalyticCost::Evaluate(double const* const* parameters, double* residuals,
                                               double** jacobians) const {
   const double* pose = parameters[0];
@@ -47,7 +48,7 @@ bool VisualReprojectionAnalyticCost::Evaluate(double const* const* parameters, d
   const Eigen::Map<const Eigen::Vector3d> t_wc(pose + 4);
   const Eigen::Map<const Eigen::Vector3d> x_w(parameters[1]);
   const Eigen::Vector3d d = x_w - t_wc;
-  const Eigen::Vector3d x_c = q_wc.conjugate() * d;
+  const Eigen::Vector3d x_c = q_wc.conjugate() * d + offset_;
   if (!(x_c.z() > VisualReprojectionCost::kMinDepth)) return false;
   const double inv_z = 1.0 / x_c.z();
   const double s = sqrt_information_;

@@ -36,14 +36,17 @@ inline Eigen::Matrix<double, 2, 3> PixelResidualJacobian(double fx, double fy, d
 // the four intrinsics instead of a camera copy: a global problem holds millions of these.
 class VisualReprojectionAnalyticCost : public ceres::SizedCostFunction<2, 7, 3> {
  public:
+  // offset as in VisualReprojectionCost.
   VisualReprojectionAnalyticCost(const PinholeCamera& camera, const Eigen::Vector2d& uv,
-                                 double sqrt_information)
+                                 double sqrt_information,
+                                 const Eigen::Vector3d& offset = Eigen::Vector3d::Zero())
       : fx_(camera.fx),
         fy_(camera.fy),
         cx_(camera.cx),
         cy_(camera.cy),
         uv_(uv),
-        sqrt_information_(sqrt_information) {}
+        sqrt_information_(sqrt_information),
+        offset_(offset) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
@@ -52,6 +55,7 @@ class VisualReprojectionAnalyticCost : public ceres::SizedCostFunction<2, 7, 3> 
   const double fx_, fy_, cx_, cy_;
   const Eigen::Vector2d uv_;
   const double sqrt_information_;
+  const Eigen::Vector3d offset_;
 };
 
 class PointToImlsAnalyticCost : public ceres::SizedCostFunction<1, 7, 7> {

@@ -94,6 +94,39 @@ TEST(VisualReprojectionAnalyticCost, MatchesAutodiffAndNumericAndFailsBehindTheC
       VisualReprojectionAnalyticCost(camera, {600, 180}, 1.0).Evaluate(params, r, nullptr));
 }
 
+// A camera beside the pose's frame (KITTI's camera 2, 6 cm left of camera 0): the residual is
+// that of the camera placed at the offset, and the Jacobians still match.
+TEST(VisualReprojectionAnalyticCost, CameraOffsetMovesTheObservingCamera) {
+  std::mt19937 rng(7);
+  const PinholeCamera camera = KittiLikeCamera();
+  const Eigen::Vector3d offset(0.061, -0.0003, 0.0062);
+  const Rigid3d camera_from_cam0(Eigen::Quaterniond::Identity(), offset);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Rigid3d world_from_cam0 = RandomPose(rng, 0.5, 10.0);
+    const Eigen::Vector3d x_c0(0.3 * trial - 1.5, 0.5, 4.0 + 4.0 * trial);
+    std::array<double, 3> point;
+    Eigen::Map<Eigen::Vector3d>(point.data()) = world_from_cam0 * x_c0;
+    const Eigen::Vector2d uv = camera.Project(x_c0 + offset) + Eigen::Vector2d(0.2, -0.1 * trial);
+    PoseBlock pose = ToPoseBlock(world_from_cam0);
+    VisualReprojectionAnalyticCost analytic(camera, uv, 1.0, offset);
+    std::unique_ptr<ceres::CostFunction> autodiff(
+        VisualReprojectionCost::Create(camera, uv, 1.0, offset));
+    ExpectSameEvaluation(analytic, *autodiff, {pose.data(), point.data()});
+    EXPECT_LT(LocalJacobianError(analytic, {true, false}, {pose.data(), point.data()}), 1e-5);
+    // The same residual as camera 2's own pose without an offset.
+    PoseBlock camera_pose = ToPoseBlock(world_from_cam0 * camera_from_cam0.Inverse());
+    VisualReprojectionAnalyticCost plain(camera, uv, 1.0);
+    const double* with[2] = {pose.data(), point.data()};
+    const double* without[2] = {camera_pose.data(), point.data()};
+    double r_with[2], r_without[2];
+    ASSERT_TRUE(analytic.Evaluate(with, r_with, nullptr));
+    ASSERT_TRUE(plain.Evaluate(without, r_without, nullptr));
+    EXPECT_NEAR(r_with[0], r_without[0], 1e-9);
+    EXPECT_NEAR(r_with[1], r_without[1], 1e-9);
+    EXPECT_NEAR(r_with[0], 0.2, 1e-9);  // s (uv - projection)
+  }
+}
+
 TEST(PointToImlsAnalyticCost, MatchesAutodiffAndNumeric) {
   std::mt19937 rng(6);
   for (int trial = 0; trial < 10; ++trial) {

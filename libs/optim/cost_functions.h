@@ -32,16 +32,19 @@ class VisualReprojectionCost {
  public:
   static constexpr double kMinDepth = 1e-6;
 
+  // offset: the observing camera's offset from the pose's frame (x_camera = x_pose + offset;
+  // a rectified camera other than camera 0, Calibration::CameraOffset).
   VisualReprojectionCost(const PinholeCamera& camera, const Eigen::Vector2d& uv,
-                         double sqrt_information)
-      : camera_(camera), uv_(uv), sqrt_information_(sqrt_information) {}
+                         double sqrt_information,
+                         const Eigen::Vector3d& offset = Eigen::Vector3d::Zero())
+      : camera_(camera), uv_(uv), sqrt_information_(sqrt_information), offset_(offset) {}
 
   template <typename T>
   bool operator()(const T* world_from_cam, const T* point_world, T* residual) const {
     const Eigen::Map<const Eigen::Quaternion<T>> q_wc(world_from_cam);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wc(world_from_cam + 4);
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> x_w(point_world);
-    const Eigen::Matrix<T, 3, 1> x_c = q_wc.conjugate() * (x_w - t_wc);
+    const Eigen::Matrix<T, 3, 1> x_c = q_wc.conjugate() * (x_w - t_wc) + offset_.cast<T>();
     if (!(x_c.z() > T(kMinDepth))) return false;
     T uv[2];
     ProjectPinhole(camera_, x_c, uv);
@@ -51,15 +54,17 @@ class VisualReprojectionCost {
   }
 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
-                                     double sqrt_information) {
+                                     double sqrt_information,
+                                     const Eigen::Vector3d& offset = Eigen::Vector3d::Zero()) {
     return new ceres::AutoDiffCostFunction<VisualReprojectionCost, 2, 7, 3>(
-        new VisualReprojectionCost(camera, uv, sqrt_information));
+        new VisualReprojectionCost(camera, uv, sqrt_information, offset));
   }
 
  private:
   const PinholeCamera camera_;
   const Eigen::Vector2d uv_;
   const double sqrt_information_;
+  const Eigen::Vector3d offset_;
 };
 
 // Point-to-IMLS-surface error e_L(n, j) (Eq. 3; supplement Eq. 1 for reused correspondences):

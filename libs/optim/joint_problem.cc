@@ -128,7 +128,8 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
     // Drop what is behind the camera now: the functor could not be evaluated (ORB-SLAM removes
     // such observations before BA as well).
     const Eigen::Vector3d x_c =
-        input.poses.at(obs.keyframe).Inverse() * input.map_points[obs.map_point];
+        input.poses.at(obs.keyframe).Inverse() * input.map_points[obs.map_point] +
+        input.camera_offset;
     if (!(x_c.z() > VisualReprojectionCost::kMinDepth)) {
       ++jp.dropped_observations;
       continue;
@@ -189,9 +190,10 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
     const double sigma = std::pow(options.octave_scale_factor, obs.octave);
     ceres::CostFunction* cost =
         options.analytic_jacobians
-            ? static_cast<ceres::CostFunction*>(
-                  new VisualReprojectionAnalyticCost(input.camera, obs.uv, 1.0 / sigma))
-            : VisualReprojectionCost::Create(input.camera, obs.uv, 1.0 / sigma);
+            ? static_cast<ceres::CostFunction*>(new VisualReprojectionAnalyticCost(
+                  input.camera, obs.uv, 1.0 / sigma, input.camera_offset))
+            : VisualReprojectionCost::Create(input.camera, obs.uv, 1.0 / sigma,
+                                             input.camera_offset);
     jp.visual_blocks.push_back(jp.problem->AddResidualBlock(cost, loss, pose, point));
     used[obs.map_point] = true;
   }

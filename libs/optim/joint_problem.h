@@ -81,6 +81,9 @@ struct RelativePoseConstraint {
 
 struct JointProblemInput {
   PinholeCamera camera;
+  // The observing camera's offset from the poses' frame (camera 0): x_camera = x_cam0 + offset.
+  // Zero for camera 0; another rectified camera's Calibration::CameraOffset (same orientation).
+  Eigen::Vector3d camera_offset = Eigen::Vector3d::Zero();
   std::map<int64_t, Rigid3d> poses;         // keyframe id -> world_from_cam (initial values)
   std::set<int64_t> fixed;                  // keyframes held constant; empty: the first id is fixed
   std::vector<Eigen::Vector3d> map_points;  // world frame

@@ -47,6 +47,13 @@ void SequenceOptions::Check() const {
   scene.Check();
   lidar.Check();
   camera.Check();
+  JVL_CHECK(!cameras.empty() || !render_images, "no camera to render");
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    JVL_CHECK(cameras[i] >= 0 && cameras[i] < 4, "camera " << cameras[i] << " is not 0..3");
+    for (size_t j = 0; j < i; ++j)
+      JVL_CHECK(cameras[i] != cameras[j], "camera " << cameras[i] << " is listed twice");
+    calibration.CheckCamera(cameras[i], "the calibration");
+  }
 }
 
 Rigid3d World::MapFromVeloAt(double t) const {
@@ -125,8 +132,20 @@ SimFrame SimulateFrame(const World& world, int64_t frame) {
   const PinholeCamera camera = opt.calibration.Camera(0);
   if (opt.render_images) {
     const double gain = ExposureGain(frame, opt.camera.exposure_variation, opt.seed);
-    out.image = RenderImage(world.scene, *world.caster, camera, map_from_cam, moving, gain,
-                            HashCombine(opt.seed, 2 * static_cast<uint64_t>(frame)), opt.camera);
+    for (const int c : opt.cameras) {
+      // Camera c at its offset from camera 0 (same orientation: rectified), its own noise.
+      const uint64_t seed = HashCombine(opt.seed, 2 * static_cast<uint64_t>(frame));
+      const CameraChoice choice = CameraChoice::Of(opt.calibration, c);
+      cv::Mat image = RenderImage(world.scene, *world.caster, opt.calibration.Camera(c),
+                                  map_from_cam * choice.camera_from_cam0().Inverse(), moving, gain,
+                                  c == 0 ? seed : HashCombine(seed, c), opt.camera);
+      if (c == 0) {
+        out.image = std::move(image);
+        continue;
+      }
+      if (c >= 2) cv::merge(std::vector<cv::Mat>{image, image, image}, image);
+      out.other_images.emplace_back(c, std::move(image));
+    }
   }
   out.vps = ComputeGroundTruthVps(world.scene, camera, map_from_cam,
                                   DriveArcLength(world.drive, out.time));

@@ -43,6 +43,9 @@ struct SequenceOptions {
   LidarOptions lidar;
   CameraOptions camera;
   bool render_images = true;
+  // The cameras rendered (0..3, each at its offset from camera 0 in the calibration); 2 and 3
+  // are written as colour images (three equal channels), as KITTI stores them.
+  std::vector<int> cameras = {0};
   bool simulate_scans = true;
   void Check() const;
 };
@@ -64,7 +67,9 @@ struct SimFrame {
   int64_t frame = 0;
   double time = 0;
   PointCloud scan;  // Velodyne frame; empty when scans are disabled.
-  cv::Mat image;    // CV_8U; empty when images are disabled.
+  cv::Mat image;  // CV_8U of camera 0; empty when images are disabled or camera 0 is not rendered.
+  std::vector<std::pair<int, cv::Mat>>
+      other_images;  // The other rendered cameras (CV_8UC3 for 2, 3).
   std::vector<GtVanishingPoint> vps;
 };
 

@@ -21,7 +21,9 @@ WriteStats WriteSequence(const World& world, const io::SequenceLayout& layout_in
   Timer timer;
   GenerateSequence(world, threads, [&](SimFrame&& f) {
     if (opt.simulate_scans) io::WriteSequenceScan(layout, f.frame, f.scan);
-    if (opt.render_images) io::WriteImage(layout.ImagePath(f.frame), f.image);
+    if (opt.render_images && !f.image.empty()) io::WriteImage(layout.ImagePath(f.frame), f.image);
+    for (const auto& [camera, image] : f.other_images)
+      io::WriteImage(layout.ImagePath(f.frame, camera), image);
     points += static_cast<int64_t>(f.scan.size());
     const size_t slot = *world.ground_truth.IndexOf(f.frame);
     for (const GtVanishingPoint& v : f.vps) {

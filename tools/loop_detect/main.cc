@@ -158,6 +158,10 @@ int main(int argc, char** argv) {
       ->required();
   cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
+  CLI::Option* camera_option =
+      cli.add_option("--camera", visual_options.camera,
+                     std::string(io::kCameraHelp) + " (with --visual: the visual map's camera)")
+          ->capture_default_str();
   cli.add_option("--poses", poses_path,
                  "Trajectory of the drive (odometry or prior: .h5 artifact, KITTI or TUM text); "
                  "only its path length is used, to skip the keyframes just driven")
@@ -250,6 +254,10 @@ int main(int argc, char** argv) {
     if (use_visual && !visual_path.empty()) {
       tool.AddInput(visual_path);
       map = io::ReadVisualMap(visual_path);
+      JVL_CHECK(camera_option->count() == 0 || map.camera_choice.index == visual_options.camera,
+                visual_path << " was built from camera " << map.camera_choice.index
+                            << ", not --camera " << visual_options.camera);
+      visual_options.camera = map.camera_choice.index;
       JVL_CHECK(std::abs(map.scale_factor - visual_options.orb.scale_factor) < 1e-9 &&
                     map.num_levels == visual_options.orb.num_levels,
                 visual_path << ": ORB pyramid " << map.num_levels << " levels x "
@@ -280,13 +288,15 @@ int main(int argc, char** argv) {
       }
     }
     if (use_visual) {
+      dataset->CheckCamera(visual_options.camera);
       std::atomic<int64_t> extracted{0};
       auto features_of = [&](int64_t f) {
         vision::OrbFeatures out;
         const auto it = rows.find(f);
         if (it == rows.end()) {
           ++extracted;
-          return vision::ExtractOrb(dataset->LoadImage(f, 0), visual_options.orb);
+          return vision::ExtractOrb(dataset->LoadImage(f, visual_options.camera),
+                                    visual_options.orb);
         }
         for (size_t p = it->second.first; p < it->second.second; ++p) {
           vision::OrbKeypoint k;

@@ -49,6 +49,11 @@ int main(int argc, char** argv) {
   cli.add_option("--preview-frame", preview,
                  "Also write sim/topview_<frame>.png, a bird's-eye view of that frame's scan");
   cli.add_flag("--no-images", no_images, "Do not render camera images");
+  cli.add_option("--cameras", opt.cameras,
+                 "Cameras to render (kitti layout; e.g. --cameras 0,2): each at its offset from "
+                 "camera 0 in the calibration, 2 and 3 as colour images")
+      ->delimiter(',')
+      ->capture_default_str();
   cli.add_flag("--no-scans", no_scans, "Do not simulate LiDAR scans");
   return tool.Run(argc, argv, [&] {
     opt.scenario = jvl::sim::ParseScenario(scenario);
@@ -56,6 +61,9 @@ int main(int argc, char** argv) {
     opt.simulate_scans = !no_scans;
     JVL_CHECK(sequence.size() == 2 && std::isdigit(sequence[0]) && std::isdigit(sequence[1]),
               "--sequence must be two digits, got '" << sequence << "'");
+    const jvl::io::SequenceLayout layout{output, sequence, jvl::io::ParseSimLayout(layout_name)};
+    JVL_CHECK(layout.layout == jvl::io::SimLayout::kKitti || opt.cameras == std::vector<int>{0},
+              "--cameras: the " << layout_name << " layout is written with camera 0 only");
     jvl::Timer timer;
     const auto world = jvl::sim::BuildWorld(opt);
     spdlog::info("world: {} triangles, {} buildings, {} frames, built in {:.2f} s",
@@ -64,7 +72,6 @@ int main(int argc, char** argv) {
     tool.SetDatasetId("sim:" + scenario + ":" + std::to_string(opt.seed));
     jvl::Progress progress("sim_sequence", static_cast<int64_t>(world->ground_truth.size()),
                            !tool.quiet());
-    const jvl::io::SequenceLayout layout{output, sequence, jvl::io::ParseSimLayout(layout_name)};
     const auto st = jvl::sim::WriteSequence(
         *world, layout, tool.threads(), [&] { return tool.MakeProvenance(); },
         [&] { progress.Tick(); });

@@ -20,11 +20,13 @@ int main(int argc, char** argv) {
                  "Build the visual map (ORB keyframes, map points, observations, covisibility) "
                  "from prior poses.");
   std::string dataset_dir, format = "auto", frames = ":", prior_path, directions_path, output;
+  int camera = 0;
   mapping::VisualMapOptions options;
   auto& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Dataset folder (KITTI sequence)")->required();
   cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
+  cli.add_option("--camera", camera, io::kCameraHelp)->capture_default_str();
   tool.InputFile(
       cli.add_option("--prior", prior_path, "Prior trajectory (.h5, KITTI or TUM)")->required());
   tool.InputFile(cli.add_option("--directions", directions_path,
@@ -38,7 +40,12 @@ int main(int argc, char** argv) {
     tool.AddDataset(*dataset, dataset_dir);
     tool.AddInput(prior_path);
     const Trajectory prior = io::ReadTrajectory(prior_path);
-    const Trajectory poses = mapping::SelectPriorPoses(prior, dataset->frames(), prior_path);
+    dataset->CheckCamera(camera);
+    const CameraChoice choice = CameraChoice::Of(dataset->calibration(), camera);
+    // The map is built in the chosen camera's frame (world_from_camera = world_from_cam0 *
+    // cam0_from_camera) and its keyframe poses are written back as world_from_cam0.
+    Trajectory poses = mapping::SelectPriorPoses(prior, dataset->frames(), prior_path);
+    for (Rigid3d& pose : poses.world_from_cam) pose = pose * choice.camera_from_cam0().Inverse();
     std::vector<int64_t> direction_frames;
     if (!directions_path.empty()) {
       for (const auto& a : io::ReadDirectionsArtifact(directions_path).associations)
@@ -47,8 +54,8 @@ int main(int argc, char** argv) {
     }
     Progress progress("visual_assoc", static_cast<int64_t>(poses.size()), !tool.quiet());
     const mapping::VisualMapResult result = mapping::BuildVisualMap(
-        dataset->calibration().Camera(0), poses, direction_frames,
-        [&](int64_t f) { return dataset->LoadImage(f, 0); }, options, tool.threads(),
+        dataset->calibration().Camera(camera), poses, direction_frames,
+        [&](int64_t f) { return dataset->LoadImage(f, camera); }, options, tool.threads(),
         [&](const mapping::FrameReport& r) {
           spdlog::debug(
               "frame {}: {} keypoints, tracked {}/{}, keyframe {} ({}), new {}, fused {}, "
@@ -63,6 +70,8 @@ int main(int argc, char** argv) {
         });
     io::VisualMapData data =
         mapping::ExportVisualMap(result.map, prior, options.min_covisibility_weight);
+    for (Rigid3d& pose : data.keyframes.world_from_cam) pose = pose * choice.camera_from_cam0();
+    data.camera_choice = choice;
     data.summary = mapping::Summarize(result, mapping::ComputeStats(data));
     io::WriteVisualMap(output, data, tool.MakeProvenance());
     std::printf("%s\n", mapping::FormatSummary(data.summary).c_str());

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
       ->required();
   cli.add_option("--format", format, jvl::io::kDatasetFormatHelp)->capture_default_str();
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
+  cli.add_option("--camera", run.camera, jvl::io::kCameraHelp)->capture_default_str();
   tool.OutputFile(cli.add_option("-o,--output", output, "Output artifact (vps.h5)")->required());
   tool.OutputFile(cli.add_option("--csv", csv, "Also write one CSV row per VP to this file"));
   cli.add_option("--debug-dir", run.debug_dir, "Write overlay images (segments by VP) here");

@@ -35,7 +35,9 @@ VpDetectRunResult RunVpDetect(const io::Dataset& dataset, const VpDetectRunOptio
   const std::vector<int64_t>& frames = dataset.frames();
   VpDetectRunResult out;
   out.data.frames = frames;
+  dataset.CheckCamera(options.camera);
   out.data.camera = dataset.calibration().Camera(options.camera);
+  out.data.camera_choice = CameraChoice::Of(dataset.calibration(), options.camera);
   if (frames.empty()) return out;
   if (out.data.camera.width <= 0) {
     const cv::Mat first = dataset.LoadImage(frames.front(), options.camera);

@@ -62,12 +62,13 @@ std::vector<lidar::StoredScan> ReadStoredScans(const std::string& path) {
 }
 
 GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual, StoredLocalMap&& local,
-                                            const io::DirectionsData* directions) {
+                                   const io::DirectionsData* directions) {
   JVL_CHECK(local.keyframes.frames == visual.keyframes.frames,
             "local and visual artifacts have different keyframes ("
                 << local.keyframes.size() << " vs " << visual.keyframes.size() << ")");
   GlobalMapInput in;
   in.camera = visual.camera;
+  in.camera_choice = visual.camera_choice;
   in.keyframes = local.keyframes;
   const size_t m = visual.num_mappoints();
   if (!local.mappoints.empty()) {

@@ -760,6 +760,7 @@ std::optional<optim::ResidualStats> DirectionCostBefore(int round, const FixedTe
     return std::nullopt;
   optim::JointProblemInput only;
   only.camera = problem.camera;
+  only.camera_offset = problem.camera_offset;
   only.poses = problem.poses;
   only.fixed = problem.fixed;
   only.directions = ToDirectionConstraints(terms.directions.priors);
@@ -828,6 +829,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   const FixedTerms terms = PrepareFixedTerms(&input, options, &result);
   optim::JointProblemInput problem;
   problem.camera = input.camera;
+  problem.camera_offset = input.camera_choice.offset;
   problem.fixed = {0};  // gauge: the first keyframe
   problem.map_points = input.map_points;
   problem.shared_observations = &input.observations;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "direction/vp_priors.h"
+#include "geometry/calibration.h"
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
 #include "geometry/trajectory.h"
@@ -47,7 +48,8 @@ struct LoopConstraint {
 // Everything the global problem needs; keyframe references are rows of `keyframes`.
 struct GlobalMapInput {
   PinholeCamera camera;
-  Trajectory keyframes;  // Frames + current (local-mapping refined) world_from_cam0.
+  CameraChoice camera_choice;  // The camera the visual map was built from (offset from cam0).
+  Trajectory keyframes;        // Frames + current (local-mapping refined) world_from_cam0.
   std::vector<Eigen::Vector3d> map_points;             // World.
   std::vector<optim::VisualObservation> observations;  // keyframe = row.
   std::vector<optim::ImlsCorrespondence> saved_imls;   // The set L; n, c = rows.

@@ -30,6 +30,7 @@ LocalMappingInput MakeLocalMappingInput(const io::VisualMapData& visual, const T
                                         const std::string& prior_name) {
   LocalMappingInput in;
   in.camera = visual.camera;
+  in.camera_choice = visual.camera_choice;
   in.frames = visual.keyframes.frames;
   in.map_poses = visual.keyframes.world_from_cam;
   for (const int64_t f : in.frames) {
@@ -53,6 +54,7 @@ io::LocalMapData ExportLocalMap(const LocalMappingInput& input, const LocalMappi
                                 const Trajectory& prior, const nlohmann::json& summary) {
   io::LocalMapData d;
   d.camera = input.camera;
+  d.camera_choice = input.camera_choice;
   d.keyframes = RefinedKeyframes(input, result);
   for (const optim::ImlsCorrespondence& l : result.correspondences) {
     d.imls_n.push_back(static_cast<int32_t>(l.n));

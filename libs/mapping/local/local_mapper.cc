@@ -91,6 +91,7 @@ LocalMapper::Problem LocalMapper::BuildProblem(
   Problem p;
   optim::JointProblemInput& in = p.input;
   in.camera = in_.camera;
+  in.camera_offset = in_.camera_choice.offset;
   const std::set<int64_t> local_set(local.begin(), local.end());
   for (const int64_t r : local) in.poses[r] = result_.poses[static_cast<size_t>(r)];
   // Step 4: the new correspondences join K_n with K_c (fixed when K_c is not local) ...

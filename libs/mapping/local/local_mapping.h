@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/calibration.h"
 #include "geometry/camera.h"
 #include "geometry/rigid3.h"
 #include "geometry/trajectory.h"
@@ -30,10 +31,11 @@ namespace jvl::mapping {
 
 struct LocalMappingInput {
   PinholeCamera camera;
-  std::vector<int64_t> frames;              // Keyframe frame ids, increasing.
-  std::vector<Rigid3d> map_poses;           // Poses the map points were triangulated with.
-  std::vector<Rigid3d> prior;               // Initial world_from_cam0 of each keyframe.
-  std::vector<Eigen::Vector3d> map_points;  // World, in the map_poses frame.
+  CameraChoice camera_choice;      // The camera the visual map was built from (offset from cam0).
+  std::vector<int64_t> frames;     // Keyframe frame ids, increasing.
+  std::vector<Rigid3d> map_poses;  // Poses the map points were triangulated with.
+  std::vector<Rigid3d> prior;      // Initial world_from_cam0 of each keyframe.
+  std::vector<Eigen::Vector3d> map_points;             // World, in the map_poses frame.
   std::vector<optim::VisualObservation> observations;  // keyframe = row.
   std::vector<std::array<int, 2>> covisibility;        // Keyframe rows.
   size_t size() const { return frames.size(); }
@@ -118,6 +120,5 @@ Trajectory RefinedKeyframes(const LocalMappingInput& input, const LocalMappingRe
 // Run summary (medians of the per-keyframe figures, counts); see schemas/local.schema.json.
 nlohmann::json SummarizeLocalMap(const LocalMappingResult& result,
                                  const LocalMappingOptions& options);
-
 
 }  // namespace jvl::mapping

@@ -153,7 +153,7 @@ VisualMapStats ComputeStats(const io::VisualMapData& d) {
     per_kf[k] += 1;
     const Eigen::Vector3d x(d.mappoint_position[3 * m], d.mappoint_position[3 * m + 1],
                             d.mappoint_position[3 * m + 2]);
-    const Eigen::Vector3d pc = cam_from_world[k] * x;
+    const Eigen::Vector3d pc = cam_from_world[k] * x + d.camera_choice.offset;
     const Eigen::Vector2d uv(d.keypoint_uv[2 * kp], d.keypoint_uv[2 * kp + 1]);
     errors.push_back(pc.z() > 0 ? (d.camera.Project(pc) - uv).norm() : 1e9);
   }
