@@ -19,11 +19,12 @@ int main(int argc, char** argv) {
   app::Tool tool("visual_assoc",
                  "Build the visual map (ORB keyframes, map points, observations, covisibility) "
                  "from prior poses.");
-  std::string dataset_dir, format = "auto", frames = ":", prior_path, directions_path, output;
+  std::string dataset_dir, frames = ":", prior_path, directions_path, output;
+  io::DatasetOptions dataset_options;
   mapping::VisualMapOptions options;
   auto& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Dataset folder (KITTI sequence)")->required();
-  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   tool.InputFile(
       cli.add_option("--prior", prior_path, "Prior trajectory (.h5, KITTI or TUM)")->required());
@@ -33,8 +34,7 @@ int main(int argc, char** argv) {
   tools::AddVisualMapFlags(tool, &options);
   return tool.Run(argc, argv, [&] {
     options.Check();
-    auto dataset =
-        io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
+    auto dataset = io::OpenDataset(dataset_dir, dataset_options, ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
     tool.AddInput(prior_path);
     const Trajectory prior = io::ReadTrajectory(prior_path);
