@@ -194,6 +194,16 @@ void Tool::CheckNotAnOutput(const std::string& path, const std::string& what) co
   }
 }
 
+void Tool::AddDatasetOptions(io::DatasetOptions* options) {
+  cli_.add_option("--format", options->format, io::kDatasetFormatHelp)->capture_default_str();
+  cli_.add_option("--lidar", options->lidar, io::kDatasetLidarHelp)
+      ->capture_default_str()
+      ->check(CLI::IsMember({"default", "left", "right", "both"}));
+  cli_.add_option("--gt-source", options->ground_truth, io::kDatasetGroundTruthHelp)
+      ->capture_default_str()
+      ->check(CLI::IsMember({"default", "ins", "radar"}));
+}
+
 void Tool::AddDataset(const io::Dataset& dataset, const std::string& source) {
   SetDatasetId(dataset.id(), source);
   for (const std::string& f : dataset.KeyFiles()) AddInput(f);

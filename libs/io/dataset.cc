@@ -298,13 +298,40 @@ std::vector<std::string> Dataset::InputFiles() const {
   return files;
 }
 
+double Dataset::ScanTimeOffsetInFrames(size_t index) const {
+  if (index >= scan_time_offsets_.size() || scan_time_offsets_[index] == 0 ||
+      timestamps_.size() < 2) {
+    return 0;
+  }
+  const size_t lo = index == 0 ? 0 : index - 1;
+  const size_t hi = std::min(index + 1, timestamps_.size() - 1);
+  const double period = (timestamps_[hi] - timestamps_[lo]) / static_cast<double>(hi - lo);
+  return period > 0 ? scan_time_offsets_[index] / period : 0;
+}
+
 std::unique_ptr<Dataset> OpenDataset(const std::string& dir, DatasetFormat format,
                                      const FrameRange& range) {
+  DatasetOptions options;
+  options.format = DatasetFormatName(format);
+  return OpenDataset(dir, options, range);
+}
+
+std::unique_ptr<Dataset> OpenDataset(const std::string& dir, const DatasetOptions& options,
+                                     const FrameRange& range) {
+  DatasetFormat format = ParseDatasetFormat(options.format);
   JVL_CHECK(IsDirectory(dir), dir << ": dataset folder not found");
   if (format == DatasetFormat::kAuto) format = DetectDatasetFormat(dir);
+  if (format == DatasetFormat::kOxford) return OpenOxfordDataset(dir, options, range);
+  JVL_CHECK(options.lidar == "default",
+            "--lidar " << options.lidar << ": " << dir << " is a " << DatasetFormatName(format)
+                       << " dataset, which has one LiDAR (the option is for oxford traversals)");
+  JVL_CHECK(options.ground_truth == "default",
+            "--gt-source " << options.ground_truth << ": " << dir << " is a "
+                           << DatasetFormatName(format)
+                           << " dataset, which has one ground truth (the option is for oxford "
+                              "traversals)");
   if (format == DatasetFormat::kKittiRaw) return OpenKittiRawDataset(dir, range);
   if (format == DatasetFormat::kKitti360) return OpenKitti360Dataset(dir, range);
-  if (format == DatasetFormat::kOxford) return OpenOxfordDataset(dir, range);
   return std::make_unique<KittiOdometryDataset>(dir, range);
 }
 

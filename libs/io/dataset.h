@@ -29,6 +29,21 @@ inline constexpr const char* kCameraHelp =
 inline constexpr const char* kDatasetFormatHelp =
     "Dataset layout: auto (detected from the folder), kitti, kitti-raw, kitti360 or oxford";
 
+// What the tools pass to the readers (--format, --lidar, --gt-source; app::Tool::
+// AddDatasetOptions adds the three). "default" leaves the choice to the layout; an option other
+// than "default" on a layout that does not offer it is a one-line error naming the layout.
+struct DatasetOptions {
+  std::string format = "auto";           // ParseDatasetFormat
+  std::string lidar = "default";         // oxford: left (the default), right or both
+  std::string ground_truth = "default";  // oxford: ins (the default when present) or radar
+};
+inline constexpr const char* kDatasetLidarHelp =
+    "LiDAR of an Oxford RobotCar traversal: left (the default), right, or both (the right sweep "
+    "merged into the left one's frame); other layouts have one LiDAR and take only 'default'";
+inline constexpr const char* kDatasetGroundTruthHelp =
+    "Ground truth of an Oxford RobotCar traversal: ins (gps/ins.csv, the default when present) or "
+    "radar (gt/radar_odometry.csv, the default otherwise); other layouts take only 'default'";
+
 class Dataset {
  public:
   virtual ~Dataset() = default;
@@ -49,6 +64,14 @@ class Dataset {
   // KITTI odometry: yes (its readme: the ego-motion during the sweep has been compensated);
   // KITTI raw: no; a sim_sequence folder: as its sim/scene.json says (lidar.motion_distortion).
   bool scans_motion_compensated() const { return scans_motion_compensated_; }
+  // Time (s) of each selected frame's scan minus its timestamp (Oxford: the sweep's time minus
+  // the image's, up to half a sweep period). Empty when every scan is taken at its frame's time
+  // (the KITTI layouts, whose scans and images are triggered together).
+  const std::vector<double>& scan_time_offsets() const { return scan_time_offsets_; }
+  // scan_time_offsets()[index] in units of the frame period around frame `index` (the centred
+  // difference of the timestamps, one-sided at the ends): the shift of the scan's time fractions
+  // that de-skewing with a per-frame motion needs. 0 without offsets or with one frame.
+  double ScanTimeOffsetInFrames(size_t index) const;
 
   // LiDAR scan of `frame` in the velodyne frame. Non-finite points are dropped and counted in
   // *dropped (a warning is logged). Throws naming the file on a missing or malformed scan.
@@ -75,6 +98,7 @@ class Dataset {
   Calibration calibration_;
   std::optional<Trajectory> ground_truth_;
   bool scans_motion_compensated_ = true;
+  std::vector<double> scan_time_offsets_;
   std::vector<std::string> ground_truth_files_;  // the files ground_truth_ was read from
   std::string image_size_source_;                // where calibration_'s image size comes from
 };
@@ -86,6 +110,9 @@ bool ResolveDeskew(const std::string& mode, const Dataset& dataset);
 // Opens `dir` (format detected unless given) and selects the frames in `range`.
 std::unique_ptr<Dataset> OpenDataset(const std::string& dir,
                                      DatasetFormat format = DatasetFormat::kAuto,
+                                     const FrameRange& range = {});
+// The same with the reader options of the tools (format, LiDAR, ground-truth source).
+std::unique_ptr<Dataset> OpenDataset(const std::string& dir, const DatasetOptions& options,
                                      const FrameRange& range = {});
 DatasetFormat DetectDatasetFormat(const std::string& dir);
 

@@ -155,6 +155,260 @@ TEST_F(OxfordTest, MissingOrMalformedFilesAreNamed) {
   EXPECT_EQ(NearestTime({}, 5), -1);
 }
 
+// A raw sweep of three columns (azimuths 0, 90 and 180 degrees) with three returns: laser 8
+// (elevation 0) at 10 m in column 0, laser 0 (elevation -0.1862) at 5 m in column 1, and laser
+// 31 at 1 m in column 2 (not longer than the minimum range: dropped). Byte pairs are
+// little-endian; the column times are kT0 + 1000 c + 2^40 (the high bytes matter).
+cv::Mat RawSweep() {
+  cv::Mat raw(kOxfordRawSweepRows, 3, CV_8UC1, cv::Scalar(0));
+  const auto put16 = [&](int row, int col, uint16_t v) {
+    raw.at<uint8_t>(row, col) = static_cast<uint8_t>(v & 0xff);
+    raw.at<uint8_t>(row + 1, col) = static_cast<uint8_t>(v >> 8);
+  };
+  for (int c = 0; c < 3; ++c) {
+    put16(96, c, static_cast<uint16_t>(9000 * c));  // 1/100 degree
+    const uint64_t t = static_cast<uint64_t>(kT0) + 1000 * c + (uint64_t{1} << 40);
+    for (int b = 0; b < 8; ++b) raw.at<uint8_t>(98 + b, c) = static_cast<uint8_t>(t >> (8 * b));
+  }
+  put16(32 + 2 * 8, 0, 5000);  // 10 m in 2 mm units
+  raw.at<uint8_t>(8, 0) = 255;
+  put16(32 + 2 * 0, 1, 2500);  // 5 m
+  raw.at<uint8_t>(0, 1) = 51;
+  put16(32 + 2 * 31, 2, 500);  // 1 m: not valid
+  raw.at<uint8_t>(31, 2) = 7;
+  return raw;
+}
+
+TEST_F(OxfordTest, RawPngSweepsAreDecodedAsTheSdkDoes) {
+  const fs::path png = dir_ / "velodyne_left" / "raw.png";
+  cv::imwrite(png.string(), RawSweep());
+  std::vector<int64_t> times;
+  const PointCloud cloud = ReadOxfordVelodynePng(png.string(), &times);
+  ASSERT_EQ(cloud.size(), 2u);
+  // Laser by laser: laser 0 (column 1) first. x = sin(az) r cos(el), y = -cos(az) r cos(el),
+  // z = r sin(el) - 0.090805.
+  const double el = -0.1862;
+  EXPECT_LT(
+      (cloud.points[0] - Eigen::Vector3d(5 * std::cos(el), 0, 5 * std::sin(el) - 0.090805)).norm(),
+      1e-12);
+  EXPECT_LT((cloud.points[1] - Eigen::Vector3d(0, -10, -0.090805)).norm(), 1e-12);
+  EXPECT_NEAR(cloud.intensity[0], 0.2, 1e-6);
+  EXPECT_NEAR(cloud.intensity[1], 1.0, 1e-6);
+  ASSERT_EQ(times.size(), 2u);
+  EXPECT_EQ(times[0], kT0 + 1000 + (int64_t{1} << 40));
+  EXPECT_EQ(times[1], kT0 + (int64_t{1} << 40));
+
+  // In a traversal: the .png is read when there is no .bin, the .bin wins when both exist.
+  const std::string t2 = std::to_string(kT0 + 110000);  // the sweep of frame 2
+  cv::imwrite((dir_ / "velodyne_left" / (t2 + ".png")).string(), RawSweep());
+  const auto ds = OpenDataset(dir_.string());
+  EXPECT_EQ(ds->LoadScan(2).size(), 3u);  // the .bin's three points
+  fs::remove(dir_ / "velodyne_left" / (t2 + ".bin"));
+  EXPECT_EQ(fs::path(ds->ScanPath(2)).filename(), t2 + ".png");
+  const PointCloud scan = ds->LoadScan(2);
+  ASSERT_EQ(scan.size(), 2u);
+  // The sensor (yaw -pi, z down) sees column 0's return 10 m along its -y: the vehicle's right,
+  // -y in the tools' axes; the firing height below the base is above it once z points up.
+  EXPECT_LT((scan.points[1] - Eigen::Vector3d(0, -10, 0.090805)).norm(), 1e-9);
+
+  // Malformed sweeps are named.
+  cv::imwrite(png.string(), cv::Mat(40, 3, CV_8UC1, cv::Scalar(0)));
+  try {
+    ReadOxfordVelodynePng(png.string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("raw.png: 40 rows, expected 106"), std::string::npos)
+        << e.what();
+  }
+  std::ofstream(png) << "not a png";
+  EXPECT_THROW(ReadOxfordVelodynePng(png.string()), Error);
+  fs::remove(dir_ / "velodyne_left" / (t2 + ".png"));
+  EXPECT_THROW(ds->LoadScan(2), Error);
+}
+
+// The right Velodyne: 0.9 m to the right of the left one, as on the car, oriented as it, with
+// sweeps at 30 ms + 50 ms k (20 ms after the left ones). Its sensor-frame point (-10, 0, 0) is
+// 10 m ahead, (0, 0, 1) 1 m below it.
+void AddRightVelodyne(const fs::path& sdk, const fs::path& dir) {
+  fs::create_directories(dir / "velodyne_right");
+  std::ofstream(sdk / "extrinsics" / "velodyne_right.txt")
+      << "-0.6 0.56 -0.27 0 0 -3.141592653589793\n";
+  std::ofstream stamps(dir / "velodyne_right.timestamps");
+  for (int k = 0; k < 8; ++k) {
+    const int64_t t = kT0 + 30000 + 50000 * k;
+    stamps << t << " 1\n";
+    const float v[8] = {-10, 0, /*y*/ 0, 0, /*z*/ 0, 1, /*i*/ 255, 255};
+    WriteBytes(dir / "velodyne_right" / (std::to_string(t) + ".bin"), v, sizeof(v));
+  }
+}
+
+TEST_F(OxfordTest, RightVelodyneAndBothMerged) {
+  AddRightVelodyne(sdk_, dir_);
+  DatasetOptions right;
+  right.lidar = "right";
+  const auto r = OpenDataset(dir_.string(), right);
+  // Frame 2 (125 ms) pairs with the right sweep at 130 ms.
+  EXPECT_EQ(fs::path(r->ScanPath(2)).filename(), std::to_string(kT0 + 130000) + ".bin");
+  EXPECT_EQ(fs::path(r->ScanPath(2)).parent_path().filename(), "velodyne_right");
+  const PointCloud rs = r->LoadScan(2);
+  ASSERT_EQ(rs.size(), 2u);
+  EXPECT_LT((rs.points[0] - Eigen::Vector3d(10, 0, 0)).norm(), 1e-9);
+  // 10 m ahead of the right LiDAR: 0.56 m right of and 0.27 m above the camera.
+  EXPECT_LT(
+      (r->calibration().cam0_from_velo * rs.points[0] - Eigen::Vector3d(0.56, -0.27, 9.4)).norm(),
+      1e-9);
+  EXPECT_NE(r->id(), OpenDataset(dir_.string())->id());
+
+  DatasetOptions both;
+  both.lidar = "both";
+  const auto b = OpenDataset(dir_.string(), both);
+  const auto left = OpenDataset(dir_.string());
+  EXPECT_LT((b->calibration().cam0_from_velo.translation() -
+             left->calibration().cam0_from_velo.translation())
+                .norm(),
+            1e-15);
+  EXPECT_EQ(b->ScanPath(2), left->ScanPath(2));
+  const PointCloud bs = b->LoadScan(2);
+  ASSERT_EQ(bs.size(), 5u);  // the left sweep's three points, then the right one's two
+  const PointCloud ls = left->LoadScan(2);
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(bs.points[i], ls.points[i]);
+  // The right sweep in the left one's frame: 10 m ahead, 0.9 m to the right (y left: -0.9).
+  EXPECT_LT((bs.points[3] - Eigen::Vector3d(10, -0.9, 0)).norm(), 1e-9);
+  EXPECT_LT((bs.points[4] - Eigen::Vector3d(0, -0.9, -1)).norm(), 1e-9);
+  EXPECT_LT(
+      (b->calibration().cam0_from_velo * bs.points[3] - Eigen::Vector3d(0.56, -0.27, 9.4)).norm(),
+      1e-9);
+}
+
+TEST_F(OxfordTest, LidarOptionErrorsAreOneLineAndNamed) {
+  auto message = [](const auto& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  DatasetOptions right;
+  right.lidar = "right";
+  EXPECT_NE(message([&] { OpenDataset(dir_.string(), right); }).find("velodyne_right.timestamps"),
+            std::string::npos);
+  DatasetOptions top;
+  top.lidar = "top";
+  EXPECT_NE(message([&] { OpenDataset(dir_.string(), top); }).find("--lidar: expected"),
+            std::string::npos);
+  DatasetOptions radar;
+  radar.ground_truth = "radar";
+  EXPECT_NE(message([&] { OpenDataset(dir_.string(), radar); }).find("gt/radar_odometry.csv"),
+            std::string::npos);
+  // A layout with one LiDAR refuses the option, naming it and the layout.
+  const fs::path kitti = sdk_ / "kitti" / "00";
+  fs::create_directories(kitti / "velodyne");
+  std::ofstream(kitti / "calib.txt") << "";
+  const std::string e = message([&] { OpenDataset(kitti.string(), right); });
+  EXPECT_NE(e.find("--lidar right"), std::string::npos) << e;
+  EXPECT_NE(e.find("kitti dataset"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  EXPECT_NE(message([&] { OpenDataset(kitti.string(), radar); }).find("--gt-source radar"),
+            std::string::npos);
+}
+
+TEST_F(OxfordTest, ScanTimeOffsetsAreSweepMinusImageTimes) {
+  const auto ds = OpenDataset(dir_.string());
+  ASSERT_EQ(ds->scan_time_offsets().size(), 6u);
+  // Frame 0 (0 ms) has the sweep at 10 ms, frame 1 (62.5 ms) the one at 60 ms.
+  EXPECT_NEAR(ds->scan_time_offsets()[0], 0.010, 1e-12);
+  EXPECT_NEAR(ds->scan_time_offsets()[1], -0.0025, 1e-12);
+  EXPECT_NEAR(ds->ScanTimeOffsetInFrames(0), 0.010 / 0.0625, 1e-9);
+  EXPECT_NEAR(ds->ScanTimeOffsetInFrames(1), -0.0025 / 0.0625, 1e-9);
+}
+
+// The same drive written as gps/ins.csv and as gt/radar_odometry.csv (the radar poses
+// P_ins T(ins)^-1 T(radar), as relative poses of the later in the earlier), sampled at the image
+// times: both give the same world_from_cam0. The car turns left (yaw -0.1 rad per frame, NED)
+// while driving north-east and climbing.
+TEST_F(OxfordTest, RadarOdometryGroundTruthMatchesTheInsOne) {
+  std::ofstream(sdk_ / "extrinsics" / "radar.txt") << "-0.71813 0.12 -0.54479 0 0.05 0\n";
+  const Rigid3d ins_ext = OxfordSe3(-1.71, 0.12, 1.19, 0, 0, 0);
+  const Rigid3d radar_ext = OxfordSe3(-0.71813, 0.12, -0.54479, 0, 0.05, 0);
+  std::vector<int64_t> times;
+  std::vector<Rigid3d> ned_from_ins;
+  for (int j = 0; j < 8; ++j) {
+    times.push_back(kT0 - 62500 + 62500 * j);
+    ned_from_ins.push_back(OxfordSe3(5735000.0 + 0.6 * j, 620000.0 + 0.2 * j, -100.0 - 0.01 * j,
+                                     0.01 * j, -0.02, 0.3 - 0.1 * j));
+  }
+  {
+    std::ofstream ins(dir_ / "gps" / "ins.csv");
+    ins << "timestamp,ins_status,latitude,longitude,altitude,northing,easting,down,utm_zone,"
+           "velocity_north,velocity_east,velocity_down,roll,pitch,yaw\n";
+    ins.precision(17);
+    for (size_t j = 0; j < times.size(); ++j) {
+      const auto v = OxfordXyzRpy(ned_from_ins[j]);
+      ins << times[j] << ",INS_SOLUTION_GOOD,51.76,-1.26,110.0," << v[0] << "," << v[1] << ","
+          << v[2] << ",30U,0,0,0," << v[3] << "," << v[4] << "," << v[5] << "\n";
+    }
+  }
+  fs::create_directories(dir_ / "gt");
+  const auto write_radar = [&](int broken_row) {
+    std::ofstream radar(dir_ / "gt" / "radar_odometry.csv");
+    radar << "source_timestamp,destination_timestamp,x,y,z,roll,pitch,yaw,"
+             "source_radar_timestamp,destination_radar_timestamp\n";
+    radar.precision(17);
+    for (size_t j = 0; j + 1 < times.size(); ++j) {
+      const Rigid3d a = ned_from_ins[j] * ins_ext.Inverse() * radar_ext;
+      const Rigid3d b = ned_from_ins[j + 1] * ins_ext.Inverse() * radar_ext;
+      const auto v = OxfordXyzRpy(a.Inverse() * b);
+      const int64_t destination = times[j] + (static_cast<int>(j) == broken_row ? 1 : 0);
+      radar << times[j + 1] << "," << destination << "," << v[0] << "," << v[1] << "," << v[2]
+            << "," << v[3] << "," << v[4] << "," << v[5] << "," << times[j + 1] - 1000 << ","
+            << times[j] - 1000 << "\n";
+    }
+  };
+  write_radar(-1);
+  DatasetOptions ins_options, radar_options;
+  ins_options.ground_truth = "ins";
+  radar_options.ground_truth = "radar";
+  const auto from_ins = OpenDataset(dir_.string(), ins_options);
+  const auto from_radar = OpenDataset(dir_.string(), radar_options);
+  ASSERT_TRUE(from_ins->ground_truth() && from_radar->ground_truth());
+  const Trajectory& a = *from_ins->ground_truth();
+  const Trajectory& b = *from_radar->ground_truth();
+  ASSERT_EQ(a.size(), 6u);
+  ASSERT_EQ(b.size(), 6u);
+  double path = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a.frames[i], b.frames[i]);
+    // 1e-7 m: the northings of 5.7e6 m carry 1e-9 m of rounding each.
+    EXPECT_LT((a.world_from_cam[i].translation() - b.world_from_cam[i].translation()).norm(), 1e-7)
+        << i;
+    EXPECT_LT(
+        RotationAngle(a.world_from_cam[i].rotation().inverse() * b.world_from_cam[i].rotation()),
+        1e-9)
+        << i;
+    if (i > 0) {
+      path += (a.world_from_cam[i].translation() - a.world_from_cam[i - 1].translation()).norm();
+    }
+  }
+  EXPECT_GT(path, 2.0);  // the drive moves: the comparison is not between two identities
+  EXPECT_GT(RotationAngle(a.world_from_cam.back().rotation()), 0.4);
+  // The default: the INS when present, else the radar odometry.
+  EXPECT_NE(from_ins->id(), from_radar->id());
+  EXPECT_EQ(OpenDataset(dir_.string())->id(), from_ins->id());
+  fs::remove(dir_ / "gps" / "ins.csv");
+  EXPECT_EQ(OpenDataset(dir_.string())->id(), from_radar->id());
+  EXPECT_THROW(OpenDataset(dir_.string(), ins_options), Error);
+  // A broken chain is named by file and line.
+  write_radar(3);
+  try {
+    OpenDataset(dir_.string());
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("radar_odometry.csv, line 5: destination_timestamp"), std::string::npos) << m;
+  }
+}
+
 TEST(OxfordSe3, RollPitchYawOrder) {
   // R = Rz(yaw) Ry(pitch) Rx(roll): a quarter yaw turns x into y whatever the roll.
   const Rigid3d t = OxfordSe3(1, 2, 3, M_PI / 2, 0, M_PI / 2);

@@ -106,12 +106,13 @@ void Odometry::UpdateModel(int64_t frame, const ScanSurface& surface,
 }
 
 OdometryFrame Odometry::ProcessScan(const PointCloud& velo_scan, int64_t frame,
-                                    int64_t non_finite_dropped) {
+                                    int64_t non_finite_dropped, double scan_time_offset) {
   const Timer timer;
   OdometryFrame out;
   out.frame = frame;
   FrameDiagnostics& d = out.diagnostics;
   PreprocessedScan pre = PreprocessScan(velo_scan, cam0_from_velo_, options_.preprocess, threads_);
+  pre.time_offset = scan_time_offset;
   d.non_finite_points = non_finite_dropped + pre.counts.non_finite;
   if (pre.counts.non_finite > 0) {
     spdlog::warn("frame {}: dropped {} non-finite points", frame, pre.counts.non_finite);

@@ -71,8 +71,11 @@ class Odometry {
 
   // Registers the next scan (velodyne frame, any number of points, may contain NaN).
   // non_finite_dropped: points the reader already dropped (added to the diagnostics).
+  // scan_time_offset: the scan's time minus the frame's, in frame periods
+  // (io::Dataset::ScanTimeOffsetInFrames); with de-skewing on, the scan is moved to the frame
+  // time with the same constant-velocity motion (PreprocessedScan::time_offset).
   OdometryFrame ProcessScan(const PointCloud& velo_scan, int64_t frame,
-                            int64_t non_finite_dropped = 0);
+                            int64_t non_finite_dropped = 0, double scan_time_offset = 0);
 
   const ImlsModel& model() const { return model_; }
   const std::vector<OdometryFrame>& frames() const { return frames_; }

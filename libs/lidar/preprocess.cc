@@ -99,7 +99,9 @@ void CorrectVerticalAngle(double angle_rad, std::vector<Eigen::Vector3d>* velo_p
 void DeskewScan(const Rigid3d& prev_from_cur, PreprocessedScan* scan) {
   const Vector6d xi = LogSE3(prev_from_cur);
   for (size_t i = 0; i < scan->points.size(); ++i) {
-    scan->points[i] = ExpSE3(static_cast<double>(scan->time_fraction[i]) * xi) * scan->points[i];
+    const double fraction = static_cast<double>(scan->time_fraction[i]);
+    const double s = scan->time_offset == 0 ? fraction : fraction + scan->time_offset;
+    scan->points[i] = ExpSE3(s * xi) * scan->points[i];
   }
 }
 

@@ -57,6 +57,10 @@ struct PreprocessedScan {
   // Acquisition time of each point as a fraction of the scan period relative to the frame
   // time, in [-0.5, 0.5], from the azimuth (used for de-skewing).
   std::vector<float> time_fraction;
+  // The scan's time minus the frame's, in frame periods, added to every time fraction when
+  // de-skewing: the points are then moved to the sensor pose at the frame time (a sweep taken
+  // 20 ms after its image is moved back to the image). 0 when scan and frame are simultaneous.
+  double time_offset = 0;
   bool ground_found = false;
   Eigen::Vector4d ground_plane = Eigen::Vector4d::Zero();  // n.p + d = 0, |n| = 1, cam0 frame.
   PreprocessCounts counts;
@@ -67,10 +71,11 @@ PreprocessedScan PreprocessScan(const PointCloud& velo_scan, const Rigid3d& cam0
                                 const PreprocessOptions& options, int threads = 1);
 
 // Constant-velocity de-skewing: `prev_from_cur` is the motion over one scan period in the scan's
-// cam0 frame; a point taken at time fraction s (PreprocessedScan::time_fraction) was seen from
-// cur_from_sensor(s) = Exp(s Log(prev_from_cur)) and is moved there, so every point is in the
-// frame-time pose. Raw scans (KITTI raw, sim_sequence --motion-distortion) need it; the KITTI
-// odometry scans are compensated already (io::Dataset::scans_motion_compensated).
+// cam0 frame; a point taken at time fraction s (PreprocessedScan::time_fraction, plus the scan's
+// time_offset) was seen from cur_from_sensor(s) = Exp(s Log(prev_from_cur)) and is moved there,
+// so every point is in the frame-time pose. Raw scans (KITTI raw, sim_sequence --motion-distortion)
+// need it; the KITTI odometry scans are compensated already
+// (io::Dataset::scans_motion_compensated).
 void DeskewScan(const Rigid3d& prev_from_cur, PreprocessedScan* scan);
 
 // The single steps, exposed for tests and for the mapping stages. Each returns a keep mask or

@@ -42,6 +42,30 @@ TEST(PreprocessTest, DeskewUndoesConstantVelocityMotion) {
   for (const Eigen::Vector3d& q : scan.points) EXPECT_LT((q - p).norm(), 1e-6);
 }
 
+// A scan taken `offset` frame periods after its frame (an Oxford sweep after its image) is moved
+// to the frame time: the observations made from cur_from_sensor(s + offset) all return to p.
+TEST(PreprocessTest, DeskewMovesALateScanToTheFrameTime) {
+  const Rigid3d prev_from_cur(
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.05, Eigen::Vector3d(0.1, 1.0, 0.0).normalized())),
+      Eigen::Vector3d(0.1, 0.0, 1.2));
+  const Vector6d xi = LogSE3(prev_from_cur);
+  const Eigen::Vector3d p(3.0, -1.0, 12.0);
+  const double offset = 0.32;  // 20 ms at 16 Hz
+  PreprocessedScan scan;
+  scan.time_offset = offset;
+  for (const float s : {-0.5f, 0.0f, 0.4f}) {
+    scan.points.push_back(ExpSE3((static_cast<double>(s) + offset) * xi).Inverse() * p);
+    scan.time_fraction.push_back(s);
+  }
+  PreprocessedScan uncompensated = scan;
+  uncompensated.time_offset = 0;
+  DeskewScan(prev_from_cur, &scan);
+  DeskewScan(prev_from_cur, &uncompensated);
+  for (const Eigen::Vector3d& q : scan.points) EXPECT_LT((q - p).norm(), 1e-6);
+  // Without the offset the points stay where the sensor was 20 ms later: 0.38 m off.
+  EXPECT_GT((uncompensated.points[1] - p).norm(), 0.3);
+}
+
 TEST(PreprocessTest, RangeCutDropsNearPointsAndNaN) {
   PointCloud scan;
   scan.points = {{3, 0, 0}, {0, 4.9, 0}, {6, 0, 0}, {0, 0, 5.1}, {20, 1, 1}};

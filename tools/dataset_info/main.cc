@@ -1,6 +1,8 @@
 // dataset_info: what a dataset folder holds, as the other tools will see it.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "app/tool.h"
 #include "core/check.h"
@@ -13,11 +15,13 @@ int main(int argc, char** argv) {
   jvl::app::Tool tool(
       "dataset_info",
       "Print the frames, calibration and ground truth of a dataset folder "
-      "(KITTI odometry sequence, KITTI raw drive, KITTI-360 drive or synthetic sequence).");
-  std::string dataset, format = "auto", frames, write_gt;
+      "(KITTI odometry sequence, KITTI raw drive, KITTI-360 drive, Oxford RobotCar traversal or "
+      "synthetic sequence).");
+  std::string dataset, frames, write_gt;
+  jvl::io::DatasetOptions dataset_options;
   bool check_scans = false, check_images = false;
   tool.cli().add_option("-d,--dataset", dataset, "Dataset folder")->required();
-  tool.cli().add_option("--format", format, jvl::io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   tool.cli().add_option("--frames", frames, "Frame range A:B (B exclusive)");
   tool.cli().add_flag("--check-scans", check_scans,
                       "Read every scan and report point counts and reading speed");
@@ -28,8 +32,7 @@ int main(int argc, char** argv) {
                         "(world_from_cam0, KITTI text with frame numbers: what evaluate --gt "
                         "takes, e.g. for KITTI-360, whose poses skip frames)");
   return tool.Run(argc, argv, [&] {
-    const auto ds = jvl::io::OpenDataset(dataset, jvl::io::ParseDatasetFormat(format),
-                                         jvl::ParseFrameRange(frames));
+    const auto ds = jvl::io::OpenDataset(dataset, dataset_options, jvl::ParseFrameRange(frames));
     const auto& c = ds->calibration();
     const auto cam = c.Camera(0);
     std::printf("dataset      %s\nformat       %s\nid           %s\n", ds->root().c_str(),
@@ -56,6 +59,22 @@ int main(int argc, char** argv) {
     } else {
       std::printf("ground truth none\n");
       JVL_CHECK(write_gt.empty(), "--write-gt: " << dataset << " has no ground truth");
+    }
+    if (!ds->scan_time_offsets().empty()) {
+      // Oxford: each scan is the sweep nearest its image, taken up to half a sweep before or
+      // after it (compensated where the tools de-skew: lidar_odom, local_map).
+      std::vector<double> ms;
+      for (const double o : ds->scan_time_offsets()) ms.push_back(1e3 * o);
+      std::vector<double> magnitude;
+      for (const double o : ms) magnitude.push_back(std::abs(o));
+      std::sort(magnitude.begin(), magnitude.end());
+      double sum = 0;
+      for (const double o : ms) sum += o;
+      std::printf(
+          "scan time    sweep minus image time: mean %+.1f ms, min %+.1f ms, max %+.1f ms, "
+          "|offset| median %.1f ms\n",
+          sum / static_cast<double>(ms.size()), *std::min_element(ms.begin(), ms.end()),
+          *std::max_element(ms.begin(), ms.end()), magnitude[magnitude.size() / 2]);
     }
     if (check_scans) {
       size_t total = 0, dropped_total = 0;

@@ -83,6 +83,8 @@ int main(int argc, char** argv) {
   cli.add_option("-d,--dataset", dataset,
                  "Dataset folder: the intrinsics if vps has no camera; must be the sequence the "
                  "VPs were detected on");
+  io::DatasetOptions dataset_options;
+  tool.AddDatasetOptions(&dataset_options);
   tool.OutputFile(
       cli.add_option("-o,--output", output, "directions artifact to write")->required());
   tool.OutputFile(
@@ -98,7 +100,7 @@ int main(int argc, char** argv) {
     tool.AddInput(prior_path);
     std::unique_ptr<io::Dataset> ds;
     if (!dataset.empty()) {
-      ds = io::OpenDataset(dataset);
+      ds = io::OpenDataset(dataset, dataset_options);
       tool.AddDataset(*ds, dataset);  // refuses a dataset of another sequence than the VPs'
     }
     const io::VpsData vps = io::ReadVpsArtifact(vps_path);

@@ -38,21 +38,22 @@ void AppendFrame(const jvl::lidar::OdometryFrame& f, double stamp, jvl::io::Odom
 
 int main(int argc, char** argv) {
   jvl::app::Tool tool("lidar_odom", "IMLS scan-to-model LiDAR odometry (prior trajectory).");
-  std::string dataset_dir, format = "auto", frames = ":", output, kitti_poses;
+  std::string dataset_dir, frames = ":", output, kitti_poses;
+  jvl::io::DatasetOptions dataset_options;
   jvl::lidar::OdometryOptions options;
   std::string deskew = "auto";
   auto& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
-  cli.add_option("--format", format, jvl::io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   tool.OutputFile(cli.add_option("-o,--output", output, "Odometry artifact (.h5)")->required());
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses, "Also write KITTI pose text here"));
   jvl::tools::AddLidarOdomFlags(tool, &options, &deskew);
   return tool.Run(argc, argv, [&] {
     options.Check();
-    const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
-                                              jvl::ParseFrameRange(frames));
+    const auto dataset =
+        jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
     options.deskew = jvl::io::ResolveDeskew(deskew, *dataset);
     jvl::lidar::Odometry odometry(dataset->calibration().cam0_from_velo, options, tool.threads());
@@ -63,7 +64,8 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < ids.size(); ++k) {
       size_t dropped = 0;
       const jvl::PointCloud scan = dataset->LoadScan(ids[k], &dropped);
-      const auto f = odometry.ProcessScan(scan, ids[k], static_cast<int64_t>(dropped));
+      const auto f = odometry.ProcessScan(scan, ids[k], static_cast<int64_t>(dropped),
+                                          dataset->ScanTimeOffsetInFrames(k));
       const auto& stamps = dataset->timestamps();
       AppendFrame(f, k < stamps.size() ? stamps[k] : static_cast<double>(ids[k]), &artifact);
       progress.Tick();

@@ -2,6 +2,7 @@
 // supplement 1.2) over the visual map of visual_assoc and the dataset's scans.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "app/tool.h"
@@ -28,7 +29,8 @@ int main(int argc, char** argv) {
   app::Tool tool("local_map",
                  "Refine keyframe poses and map points by joint visual / point-to-IMLS local "
                  "optimisation of each keyframe.");
-  std::string visual_path, dataset_dir, format = "auto", prior_path, output, kitti_poses;
+  std::string visual_path, dataset_dir, prior_path, output, kitti_poses;
+  io::DatasetOptions dataset_options;
   std::string deskew = "auto";
   mapping::LocalMappingOptions options;
   mapping::ScanOptions scan_options;
@@ -36,7 +38,7 @@ int main(int argc, char** argv) {
   tool.InputFile(
       cli.add_option("--visual", visual_path, "visual.h5 from visual_assoc")->required());
   cli.add_option("--dataset", dataset_dir, "Dataset folder (the scans)")->required();
-  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--deskew", deskew,
                  "Constant-velocity de-skewing of each keyframe's scan with the prior's motion: "
                  "auto (when the dataset's scans are not motion-compensated: KITTI raw, "
@@ -64,7 +66,7 @@ int main(int argc, char** argv) {
     }
     const auto input = mapping::MakeLocalMappingInput(
         visual, prior, prior_path.empty() ? visual_path + " (prior)" : prior_path);
-    auto dataset = io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), FrameRange());
+    auto dataset = io::OpenDataset(dataset_dir, dataset_options, FrameRange());
     tool.AddDataset(*dataset, dataset_dir);
     const Rigid3d cam0_from_velo = dataset->calibration().cam0_from_velo;
     const bool deskew_scans = io::ResolveDeskew(deskew, *dataset);
@@ -75,9 +77,12 @@ int main(int argc, char** argv) {
           const PointCloud scan = dataset->LoadScan(input.frames[row]);
           const std::optional<Rigid3d> sweep =
               deskew_scans ? mapping::SweepMotion(prior, input.frames[row]) : std::nullopt;
+          const auto& ids = dataset->frames();
+          const size_t index = static_cast<size_t>(
+              std::lower_bound(ids.begin(), ids.end(), input.frames[row]) - ids.begin());
           mapping::KeyframeScan prepared = mapping::PrepareKeyframeScan(
               scan, cam0_from_velo, scan_options, options.association.samples_per_list,
-              tool.threads(), sweep);
+              tool.threads(), sweep, dataset->ScanTimeOffsetInFrames(index));
           // An empty scan is reported by the dataset; a nearly empty or degenerate one (all
           // points at the origin, a few points) leaves the keyframe's IMLS term weak or empty.
           if (!scan.empty() && prepared.sampled.size() < kFewSurfacePoints) {

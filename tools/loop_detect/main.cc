@@ -145,18 +145,18 @@ int main(int argc, char** argv) {
                  "visual one by PnP on the LiDAR depth of the earlier image and then the scan "
                  "registration; every verified candidate, accepted or not, goes to the loops "
                  "artifact.");
-  std::string dataset_dir, format = "auto", frames = ":", poses_path, output, gt_path, csv,
-                           visual_path;
+  std::string dataset_dir, frames = ":", poses_path, output, gt_path, csv, visual_path;
   int every = 5;
   int scan_cache = 1024;
   std::vector<std::string> detectors = {"lidar", "visual"};
   std::string vocabulary_path = JVL_DEFAULT_VOCABULARY;
+  io::DatasetOptions dataset_options;
   loop::LidarLoopOptions options;
   loop::VisualLoopOptions visual_options;
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
-  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   CLI::Option* camera_option =
       cli.add_option("--camera", visual_options.camera,
@@ -236,8 +236,7 @@ int main(int argc, char** argv) {
       tool.AddInput(vocabulary_path, /*same_dataset=*/false);  // Serves every sequence.
       vocabulary = loop::Vocabulary::Load(vocabulary_path);
     }
-    const auto dataset =
-        io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
+    const auto dataset = io::OpenDataset(dataset_dir, dataset_options, ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
     tool.AddInput(poses_path);
     const Trajectory poses = io::ReadTrajectory(poses_path);

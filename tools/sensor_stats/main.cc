@@ -25,7 +25,8 @@ int main(int argc, char** argv) {
                       "Statistics of the raw LiDAR scans and camera images of a sequence (real or "
                       "simulated), for the simulator's fidelity table: median, 10 % and 90 % "
                       "quantile over the frames of every statistic, and the per-frame values.");
-  std::string dataset_dir, format = "auto", frames = ":", output;
+  std::string dataset_dir, frames = ":", output;
+  jvl::io::DatasetOptions dataset_options;
   int every = 1;
   bool no_scans = false, no_images = false;
   jvl::fidelity::ScanStatsOptions scan_options;
@@ -33,7 +34,7 @@ int main(int argc, char** argv) {
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
-  cli.add_option("--format", format, jvl::io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   cli.add_option("--every", every, "Use every K-th frame of the range")
       ->capture_default_str()
@@ -59,8 +60,8 @@ int main(int argc, char** argv) {
     image_options.Check();
     JVL_CHECK(!(no_scans && no_images), "sensor_stats: --no-scans and --no-images leave nothing");
     cv::setNumThreads(1);  // Parallelism is over frames.
-    const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
-                                              jvl::ParseFrameRange(frames));
+    const auto dataset =
+        jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
     std::vector<int64_t> used;
     for (size_t i = 0; i < dataset->frames().size(); i += static_cast<size_t>(every))

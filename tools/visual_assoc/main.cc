@@ -19,12 +19,13 @@ int main(int argc, char** argv) {
   app::Tool tool("visual_assoc",
                  "Build the visual map (ORB keyframes, map points, observations, covisibility) "
                  "from prior poses.");
-  std::string dataset_dir, format = "auto", frames = ":", prior_path, directions_path, output;
+  std::string dataset_dir, frames = ":", prior_path, directions_path, output;
+  io::DatasetOptions dataset_options;
   int camera = 0;
   mapping::VisualMapOptions options;
   auto& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Dataset folder (KITTI sequence)")->required();
-  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   cli.add_option("--camera", camera, io::kCameraHelp)->capture_default_str();
   tool.InputFile(
@@ -35,8 +36,7 @@ int main(int argc, char** argv) {
   tools::AddVisualMapFlags(tool, &options);
   return tool.Run(argc, argv, [&] {
     options.Check();
-    auto dataset =
-        io::OpenDataset(dataset_dir, io::ParseDatasetFormat(format), ParseFrameRange(frames));
+    auto dataset = io::OpenDataset(dataset_dir, dataset_options, ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
     tool.AddInput(prior_path);
     const Trajectory prior = io::ReadTrajectory(prior_path);

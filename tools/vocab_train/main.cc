@@ -22,14 +22,15 @@ int main(int argc, char** argv) {
                  "sequences given, clustered into a tree of branching^depth words by "
                  "hierarchical k-majority, with inverse document frequencies over those images.");
   std::vector<std::string> datasets;
-  std::string format = "auto", frames = ":", output;
+  std::string frames = ":", output;
+  io::DatasetOptions dataset_options;
   int every = 10, camera = 0;
   loop::VocabularyOptions options;
   vision::OrbOptions orb;
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", datasets, "Sequence folders to train on (repeat the option)")
       ->required();
-  cli.add_option("--format", format, io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B of every sequence (B exclusive)")
       ->capture_default_str();
   cli.add_option("--every", every, "Use every K-th image")
@@ -57,8 +58,7 @@ int main(int argc, char** argv) {
     std::vector<std::unique_ptr<io::Dataset>> opened;
     std::vector<Image> images;
     for (const std::string& dir : datasets) {
-      opened.push_back(
-          io::OpenDataset(dir, io::ParseDatasetFormat(format), ParseFrameRange(frames)));
+      opened.push_back(io::OpenDataset(dir, dataset_options, ParseFrameRange(frames)));
       // Inputs, but no sequence id: a vocabulary serves every sequence.
       for (const std::string& f : opened.back()->KeyFiles()) tool.AddInput(f, false);
       const auto& f = opened.back()->frames();

@@ -13,13 +13,14 @@
 
 int main(int argc, char** argv) {
   jvl::app::Tool tool("vp_detect", "Detect up to 3 vanishing points in every left image.");
-  std::string dataset_dir, format = "auto", frames = ":", output, csv;
+  std::string dataset_dir, frames = ":", output, csv;
+  jvl::io::DatasetOptions dataset_options;
   jvl::VpDetectRunOptions run;
   std::string detector = jvl::ToString(run.detect.segments.detector);
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
-  cli.add_option("--format", format, jvl::io::kDatasetFormatHelp)->capture_default_str();
+  tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   cli.add_option("--camera", run.camera, jvl::io::kCameraHelp)->capture_default_str();
   tool.OutputFile(cli.add_option("-o,--output", output, "Output artifact (vps.h5)")->required());
@@ -33,8 +34,8 @@ int main(int argc, char** argv) {
     run.threads = tool.threads();
     run.progress = !tool.quiet();
     cv::setNumThreads(1);  // Parallelism is over frames; keep OpenCV single-threaded inside.
-    const auto dataset = jvl::io::OpenDataset(dataset_dir, jvl::io::ParseDatasetFormat(format),
-                                              jvl::ParseFrameRange(frames));
+    const auto dataset =
+        jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
     const jvl::VpDetectRunResult result = jvl::RunVpDetect(*dataset, run);
     jvl::io::WriteVpsArtifact(output, result.data, tool.MakeProvenance());

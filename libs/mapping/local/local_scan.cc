@@ -26,9 +26,11 @@ void ScanOptions::Check() const {
 
 KeyframeScan PrepareKeyframeScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
                                  const ScanOptions& options, int samples_per_list, int threads,
-                                 const std::optional<Rigid3d>& sweep_motion) {
+                                 const std::optional<Rigid3d>& sweep_motion,
+                                 double scan_time_offset) {
   lidar::PreprocessedScan pre =
       lidar::PreprocessScan(velo_scan, cam0_from_velo, options.preprocess, threads);
+  pre.time_offset = scan_time_offset;
   if (sweep_motion) lidar::DeskewScan(*sweep_motion, &pre);
   const lidar::ScanSurface surface = lidar::ComputeSurface(pre.points, options.surface, threads);
   KeyframeScan scan = FromSurface(surface, samples_per_list, options.stored_voxel);

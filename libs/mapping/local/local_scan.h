@@ -41,10 +41,13 @@ struct KeyframeScan {
 
 // Preprocessing (supplement 1.1), normals and sampling lists (IMLS-SLAM Sec. V) of a velodyne
 // scan, for samples_per_list points per list. With `sweep_motion` (the motion over one scan
-// period, prev_from_cur in cam0) the points are de-skewed first (lidar::DeskewScan).
+// period, prev_from_cur in cam0) the points are de-skewed first (lidar::DeskewScan), and moved
+// to the frame time if the scan was taken `scan_time_offset` frame periods after it
+// (io::Dataset::ScanTimeOffsetInFrames).
 KeyframeScan PrepareKeyframeScan(const PointCloud& velo_scan, const Rigid3d& cam0_from_velo,
                                  const ScanOptions& options, int samples_per_list, int threads,
-                                 const std::optional<Rigid3d>& sweep_motion = std::nullopt);
+                                 const std::optional<Rigid3d>& sweep_motion = std::nullopt,
+                                 double scan_time_offset = 0);
 
 // The motion over one frame period at `frame` from a trajectory (constant velocity, centred:
 // half the motion from frame - 1 to frame + 1, or the one-sided motion at the ends); nullopt
