@@ -286,6 +286,11 @@ void Dataset::CheckCamera(int camera) const {
       format_ != DatasetFormat::kOxford || camera == 0,
       root_ << ": camera " << camera << " is not read; camera 0 is the stereo rig's centre camera");
   calibration_.CheckCamera(camera, root_);
+  if (!frames_.empty()) {
+    const std::string first = ImagePath(frames_.front(), camera);
+    JVL_CHECK(FileExists(first), first << ": missing image of camera " << camera << " for frame "
+                                       << frames_.front() << " (the first selected frame)");
+  }
 }
 
 std::vector<std::string> Dataset::InputFiles() const {

@@ -151,6 +151,10 @@ TEST_F(BadDatasetTest, ColourCameraImagesAreReadAsGrey) {
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { ds->CheckCamera(5); }).find("--camera 5 is not a camera"),
             std::string::npos);
+  // A camera without images is refused before any work, naming the first selected frame.
+  EXPECT_NE(ErrorOf([&] { ds->CheckCamera(0); })
+                .find("image_0/000000.png: missing image of camera 0 for frame 0"),
+            std::string::npos);
 }
 
 // KITTI odometry scans are motion-compensated; a sim_sequence folder says in sim/scene.json.
