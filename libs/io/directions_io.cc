@@ -5,6 +5,7 @@
 #include <set>
 
 #include "core/check.h"
+#include "io/camera_io.h"
 #include "io/files.h"
 
 namespace jvl::io {
@@ -50,6 +51,7 @@ void WriteDirectionsArtifact(const std::string& path, const DirectionsData& data
   w.WriteArray("associations/vp_index", vp_index);
   w.WriteArray("associations/uv", uv, {a, 2});
   w.WriteArray("associations/cluster", cluster);
+  WriteCameraChoice(w, data.camera_choice);
   w.WriteJson("summary", data.summary);
   w.Commit(provenance);
 }
@@ -57,6 +59,7 @@ void WriteDirectionsArtifact(const std::string& path, const DirectionsData& data
 DirectionsData ReadDirectionsArtifact(const std::string& path) {
   const H5Reader r(path, "directions", 1);
   DirectionsData data;
+  data.camera_choice = ReadCameraChoice(r);
   const auto id = r.ReadArray<int32_t>("clusters/id");
   const size_t c = id.size();
   const auto dir = r.ReadArray<double>("clusters/direction", 3);

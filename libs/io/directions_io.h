@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/calibration.h"
 #include "geometry/camera.h"
 #include "io/artifact.h"
 
@@ -34,6 +35,8 @@ struct DirectionsData {
   std::vector<DirectionClusterRow> clusters;
   std::vector<DirectionAssociationRow> associations;
   nlohmann::json summary = nlohmann::json::object();  // Counts per step, ground frame, ...
+  // The camera of the VP pixels (associations/uv): the vps artifact's (camera 0 when absent).
+  CameraChoice camera_choice;
 };
 
 void WriteDirectionsArtifact(const std::string& path, const DirectionsData& data,

@@ -5,6 +5,7 @@
 
 #include "core/check.h"
 #include "core/strings.h"
+#include "io/camera_io.h"
 #include "io/files.h"
 
 namespace jvl::io {
@@ -14,6 +15,7 @@ void WriteLoopsArtifact(const std::string& path, const LoopsData& data,
   const int64_t m = static_cast<int64_t>(data.loops.size());
   H5Writer writer(path, kLoopsSchema, kLoopsSchemaVersion);
   writer.WriteArray("keyframes", data.keyframes);
+  WriteCameraChoice(writer, data.camera_choice);
   std::vector<int64_t> query, match;
   std::vector<int32_t> detector, status, correspondences, inliers;
   std::vector<double> pose, score, ring, yaw, residual;
@@ -68,6 +70,7 @@ LoopsData ReadLoopsArtifact(const std::string& path) {
   H5Reader reader(path, kLoopsSchema, kLoopsSchemaVersion);
   LoopsData data;
   data.keyframes = reader.ReadArray<int64_t>("keyframes");
+  data.camera_choice = ReadCameraChoice(reader);
   JVL_CHECK(
       std::is_sorted(data.keyframes.begin(), data.keyframes.end()) &&
           std::adjacent_find(data.keyframes.begin(), data.keyframes.end()) == data.keyframes.end(),

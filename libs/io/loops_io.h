@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/calibration.h"
 #include "geometry/rigid3.h"
 #include "io/artifact.h"
 
@@ -44,6 +45,8 @@ struct LoopRecord {
 struct LoopsData {
   std::vector<int64_t> keyframes;  // Frames searched, increasing.
   std::vector<LoopRecord> loops;   // Ordered by query.
+  // The camera of the loop points' pixels (loop_detect --camera; camera 0 when absent).
+  CameraChoice camera_choice;
 };
 
 void WriteLoopsArtifact(const std::string& path, const LoopsData& data,

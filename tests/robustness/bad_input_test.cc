@@ -331,6 +331,25 @@ TEST_F(BadInputTest, DamagedImages) {
   ExpectError("dataset_info", "-d " + first_bad, "000000.png: empty image file");
 }
 
+// --camera: a camera number out of range, a camera without images (run_a has camera 0 only),
+// and artifacts of two cameras mixed (run_cam2's visual map with run_a's camera-0 directions).
+TEST_F(BadInputTest, CameraChoice) {
+  ExpectError("vp_detect", "--dataset " + kSeq + " --camera 9 -o " + Bad("x.h5"),
+              "--camera 9 is not a camera (0..3)");
+  ExpectError("vp_detect", "--dataset " + kSeq + " --camera 2 -o " + Bad("x.h5"),
+              "image_2/000000.png: missing image of camera 2 for frame 0");
+  ExpectError("visual_assoc",
+              "--dataset " + kSeq + " --camera 2 --prior " + In("prior.h5") + " -o " + Bad("x.h5"),
+              "missing image of camera 2 for frame 0");
+  const std::string cam2 = std::string(JVL_BINARY_DIR) + "/tests/robustness/run_cam2/";
+  if (!io::FileExists(cam2 + "global.h5")) GTEST_SKIP() << cam2 << " incomplete";
+  ExpectError("global_opt",
+              "--local " + cam2 + "local.h5 --visual " + cam2 + "visual.h5 --directions " +
+                  In("directions.h5") + " -o " + Bad("x.h5"),
+              "its vanishing points are pixels of camera 0, but " + cam2 +
+                  "visual.h5 was built from camera 2");
+}
+
 TEST_F(BadInputTest, TruncatedAndWrongArtifacts) {
   for (const std::string a : {"prior.h5", "vps.h5", "directions.h5", "visual.h5", "local.h5"}) {
     WriteFile(Bad("cut_" + a), Head(In(a), io::FileSize(In(a)) / 2));

@@ -20,13 +20,15 @@ int main(int argc, char** argv) {
   std::string dataset, frames, write_gt;
   jvl::io::DatasetOptions dataset_options;
   bool check_scans = false, check_images = false;
+  int camera = 0;
   tool.cli().add_option("-d,--dataset", dataset, "Dataset folder")->required();
   tool.AddDatasetOptions(&dataset_options);
   tool.cli().add_option("--frames", frames, "Frame range A:B (B exclusive)");
   tool.cli().add_flag("--check-scans", check_scans,
                       "Read every scan and report point counts and reading speed");
   tool.cli().add_flag("--check-images", check_images,
-                      "Read every camera-0 image and report the reading speed");
+                      "Read every image of --camera and report the reading speed");
+  tool.cli().add_option("--camera", camera, jvl::io::kCameraHelp)->capture_default_str();
   tool.cli().add_option("--write-gt", write_gt,
                         "Write the ground truth of the selected frames as the tools see it "
                         "(world_from_cam0, KITTI text with frame numbers: what evaluate --gt "
@@ -94,10 +96,11 @@ int main(int argc, char** argv) {
           ds->frames().size() / std::max(seconds, 1e-9));
     }
     if (check_images) {
+      ds->CheckCamera(camera);
       jvl::Progress progress("images", static_cast<int64_t>(ds->frames().size()), !tool.quiet());
       jvl::Timer timer;
       for (int64_t f : ds->frames()) {
-        ds->LoadImage(f, 0);
+        ds->LoadImage(f, camera);
         progress.Tick();
       }
       std::printf("images       read at %.1f images/s\n",

@@ -122,7 +122,8 @@ int main(int argc, char** argv) {
           "run without direction priors",
           result.stats.input_vps, vps_path);
     }
-    const io::DirectionsData data = ToData(result, o.v_interval);
+    io::DirectionsData data = ToData(result, o.v_interval);
+    data.camera_choice = vps.camera_choice;
     io::WriteDirectionsArtifact(output, data, tool.MakeProvenance());
     if (!csv.empty()) io::WriteDirectionsCsv(csv, data);
     if (!plot.empty()) io::WriteImage(plot, direction::RenderTopView(prior, result));

@@ -90,10 +90,19 @@ int main(int argc, char** argv) {
                            << local.keyframes.size() << " vs " << visual.keyframes.size()
                            << "): local_map must have run on this visual artifact");
       io::WarnIfCovisibilitySplit(visual, visual_path);
+      // Pixels of one artifact must be of the camera the visual map was built from.
+      auto same_camera = [&](const CameraChoice& c, const std::string& path, const char* what) {
+        JVL_CHECK(c.index == visual.camera_choice.index,
+                  path << ": " << what << " are pixels of camera " << c.index << ", but "
+                       << visual_path << " was built from camera " << visual.camera_choice.index
+                       << " (run the image stages with the same --camera)");
+      };
       io::DirectionsData directions;
       if (!directions_path.empty()) {
         directions = io::ReadDirectionsArtifact(directions_path);
         tool.AddInput(directions_path);
+        if (!directions.associations.empty())
+          same_camera(directions.camera_choice, directions_path, "its vanishing points");
         if (!flags.no_direction && directions.associations.empty()) {
           spdlog::warn("{}: no direction prior (no associated VP); optimising without e_D",
                        directions_path);
@@ -131,7 +140,11 @@ int main(int argc, char** argv) {
           return best;
         };
         int64_t accepted = 0, unplaced = 0;
-        for (const io::LoopRecord& r : io::ReadLoopsArtifact(loops_path).loops) {
+        const io::LoopsData loops_data = io::ReadLoopsArtifact(loops_path);
+        for (const io::LoopRecord& r : loops_data.loops)
+          if (r.status == 0 && !r.points.empty())
+            same_camera(loops_data.camera_choice, loops_path, "its loop points");
+        for (const io::LoopRecord& r : loops_data.loops) {
           if (r.status != 0) continue;
           ++accepted;
           const auto q = nearest(r.query), m = nearest(r.match);

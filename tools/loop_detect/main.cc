@@ -275,6 +275,8 @@ int main(int argc, char** argv) {
       release(map.observation_keypoint), release(map.observation_mappoint);
       release(map.covisibility_edges), release(map.covisibility_weight);
     }
+    // The camera is checked before the LiDAR detector's minutes of work.
+    if (use_visual) dataset->CheckCamera(visual_options.camera);
     std::vector<loop::LoopCandidate> candidates;
     std::vector<int64_t> lidar_closed;  // Queries the LiDAR detector accepted.
     if (use_lidar) {
@@ -287,7 +289,6 @@ int main(int argc, char** argv) {
       }
     }
     if (use_visual) {
-      dataset->CheckCamera(visual_options.camera);
       std::atomic<int64_t> extracted{0};
       auto features_of = [&](int64_t f) {
         vision::OrbFeatures out;
@@ -332,6 +333,8 @@ int main(int argc, char** argv) {
                      });
     io::LoopsData data;
     data.keyframes = keyframes.frames;
+    if (use_visual)
+      data.camera_choice = CameraChoice::Of(dataset->calibration(), visual_options.camera);
     int accepted = 0;
     for (const loop::LoopCandidate& c : candidates) {
       io::LoopRecord r;

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
                       "quantile over the frames of every statistic, and the per-frame values.");
   std::string dataset_dir, frames = ":", output;
   jvl::io::DatasetOptions dataset_options;
-  int every = 1;
+  int every = 1, camera = 0;
   bool no_scans = false, no_images = false;
   jvl::fidelity::ScanStatsOptions scan_options;
   jvl::fidelity::ImageStatsOptions image_options;
@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
       ->required();
   tool.AddDatasetOptions(&dataset_options);
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
+  cli.add_option("--camera", camera, jvl::io::kCameraHelp)->capture_default_str();
   cli.add_option("--every", every, "Use every K-th frame of the range")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -63,6 +64,7 @@ int main(int argc, char** argv) {
     const auto dataset =
         jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
+    if (!no_images) dataset->CheckCamera(camera);
     std::vector<int64_t> used;
     for (size_t i = 0; i < dataset->frames().size(); i += static_cast<size_t>(every))
       used.push_back(dataset->frames()[i]);
@@ -73,7 +75,8 @@ int main(int argc, char** argv) {
       if (!no_scans)
         scans[i] = jvl::fidelity::ComputeScanStats(dataset->LoadScan(used[i]), scan_options);
       if (!no_images)
-        images[i] = jvl::fidelity::ComputeImageStats(dataset->LoadImage(used[i]), image_options);
+        images[i] =
+            jvl::fidelity::ComputeImageStats(dataset->LoadImage(used[i], camera), image_options);
       progress.Tick();
     });
     nlohmann::json body;

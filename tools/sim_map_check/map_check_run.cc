@@ -147,7 +147,9 @@ MapCheckRunResult RunMapCheck(const sim::World& world, const io::VisualMapData& 
     result.max_keyframe_rotation_error_deg =
         std::max(result.max_keyframe_rotation_error_deg,
                  RotationAngle(truth.rotation().inverse() * pose.rotation()) * kRadToDeg);
-    map_from_cam.push_back(world.map_from_world * pose);
+    // The points were seen from the map's camera, at its offset from camera 0.
+    map_from_cam.push_back(world.map_from_world * pose *
+                           visual.camera_choice.camera_from_cam0().Inverse());
     times.push_back(gt.timestamps[*i]);
   }
   std::vector<Eigen::Vector3d> points(visual.num_mappoints());
@@ -178,9 +180,10 @@ std::vector<double> KeypointConsistency(const sim::World& world, const io::Visua
   for (size_t o = 0; o < visual.num_observations(); ++o) {
     observations[static_cast<size_t>(visual.observation_mappoint[o])].push_back(o);
   }
-  std::vector<Rigid3d> map_from_cam;
+  std::vector<Rigid3d> map_from_cam;  // of the map's camera
   for (const Rigid3d& pose : visual.keyframes.world_from_cam) {
-    map_from_cam.push_back(world.map_from_world * pose);
+    map_from_cam.push_back(world.map_from_world * pose *
+                           visual.camera_choice.camera_from_cam0().Inverse());
   }
   const auto uv = [&](size_t keypoint) {
     return Eigen::Vector2d(visual.keypoint_uv[2 * keypoint], visual.keypoint_uv[2 * keypoint + 1]);
@@ -231,10 +234,10 @@ std::string FormatPointsCsv(const MapCheckRunResult& result, const sim::World& w
     ++observations[p];
     const Eigen::Vector3d x(visual.mappoint_position[3 * p], visual.mappoint_position[3 * p + 1],
                             visual.mappoint_position[3 * p + 2]);
-    rays[p].push_back(
-        (x - visual.keyframes.world_from_cam[static_cast<size_t>(visual.observation_keyframe[o])]
-                 .translation())
-            .normalized());
+    const Rigid3d world_from_camera =
+        visual.keyframes.world_from_cam[static_cast<size_t>(visual.observation_keyframe[o])] *
+        visual.camera_choice.camera_from_cam0().Inverse();
+    rays[p].push_back((x - world_from_camera.translation()).normalized());
   }
   std::string out =
       "point,x,y,z,frame,depth,hit,surface,along_ray,perpendicular,cos_incidence,observations,"

@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
     std::vector<Image> images;
     for (const std::string& dir : datasets) {
       opened.push_back(io::OpenDataset(dir, dataset_options, ParseFrameRange(frames)));
+      opened.back()->CheckCamera(camera);
       // Inputs, but no sequence id: a vocabulary serves every sequence.
       for (const std::string& f : opened.back()->KeyFiles()) tool.AddInput(f, false);
       const auto& f = opened.back()->frames();
