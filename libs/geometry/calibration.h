@@ -12,9 +12,10 @@
 namespace jvl {
 
 struct Calibration {
-  std::array<Eigen::Matrix<double, 3, 4>, 4> P{};  // P0..P3 (rectified, cam0 frame).
-  Rigid3d cam0_from_velo;                          // Tr.
-  int image_width = 0, image_height = 0;           // 0 if unknown.
+  // P0..P3 (rectified, cam0 frame); all zero until set (Eigen leaves a matrix uninitialised).
+  std::array<Eigen::Matrix<double, 3, 4>, 4> P = ZeroProjections();
+  Rigid3d cam0_from_velo;                 // Tr.
+  int image_width = 0, image_height = 0;  // 0 if unknown.
 
   // Intrinsics of camera i from P_i (K is the left 3x3 block).
   PinholeCamera Camera(int i = 0) const;
@@ -25,6 +26,12 @@ struct Calibration {
   // Throws a one-line error naming `source` unless camera i has a projection (a positive focal
   // length and principal point: P_i is not all zero).
   void CheckCamera(int i, const std::string& source) const;
+
+  static std::array<Eigen::Matrix<double, 3, 4>, 4> ZeroProjections() {
+    std::array<Eigen::Matrix<double, 3, 4>, 4> p;
+    for (auto& m : p) m.setZero();
+    return p;
+  }
 };
 
 // The camera an image stage used: its index and its offset from camera 0 (x_camera = x_cam0 +
