@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <map>
 #include <utility>
 
@@ -35,8 +36,9 @@ void VisualMapOptions::Check() const {
   pose.Check();
 }
 
-VisualMapBuilder::VisualMapBuilder(const PinholeCamera& camera, const VisualMapOptions& options)
-    : options_(options) {
+VisualMapBuilder::VisualMapBuilder(const PinholeCamera& camera, const VisualMapOptions& options,
+                                   int threads)
+    : options_(options), threads_(std::max(1, threads)) {
   options_.Check();
   camera.Check();
   JVL_CHECK(camera.width > 0 && camera.height > 0, "visual map: camera image size unknown");
@@ -206,16 +208,21 @@ FrameReport VisualMapBuilder::AddFrame(int64_t frame, const Rigid3d& world_from_
     kf.has_direction = has_direction;
     map_.keyframes.push_back(std::move(kf));
     const int k = static_cast<int>(map_.keyframes.size()) - 1;
+    // The tracked keypoints (one per point) are aligned first, in parallel: an alignment reads
+    // its point's position and patch, which refining another point does not change.
+    std::vector<std::pair<int, int>> tracked;  // (point, keypoint)
     for (size_t i = 0; i < keypoint_point.size(); ++i) {
-      if (keypoint_point[i] < 0) continue;
-      if (!AlignKeypoint(keypoint_point[i], k, static_cast<int>(i)) && options_.require_alignment) {
-        continue;
-      }
-      AddObservation(&map_, keypoint_point[i], k, static_cast<int>(i));
+      if (keypoint_point[i] >= 0) tracked.emplace_back(keypoint_point[i], static_cast<int>(i));
+    }
+    const std::vector<Alignment> aligned = ComputeAlignments(tracked, k);
+    for (size_t t = 0; t < tracked.size(); ++t) {
+      const auto [point, keypoint] = tracked[t];
+      if (!ApplyAlignment(aligned[t], k, keypoint) && options_.require_alignment) continue;
+      AddObservation(&map_, point, k, keypoint);
       if (options_.refine_on_insert) {
-        RefineAndCheck(keypoint_point[i]);
+        RefineAndCheck(point);
       } else {
-        UpdatePointGeometry(&map_, keypoint_point[i]);
+        UpdatePointGeometry(&map_, point);
       }
     }
     const size_t before = map_.points.size();
@@ -287,29 +294,47 @@ VisualMapResult BuildVisualMap(const PinholeCamera& camera, const Trajectory& po
   std::unique_ptr<VisualMapBuilder> builder;
   const int64_t n = static_cast<int64_t>(poses.size());
   const int64_t batch = std::max(1, threads) * 2;
-  for (int64_t start = 0; start < n; start += batch) {
+  struct Batch {
+    std::vector<vision::OrbFeatures> features;
+    std::vector<double> ms;
+    std::vector<cv::Size> sizes;
+  };
+  const auto extract = [&](int64_t start) {
     const int64_t m = std::min(batch, n - start);
-    std::vector<vision::OrbFeatures> features(m);
-    std::vector<double> ms(m);
-    std::vector<cv::Size> sizes(m);
+    Batch b;
+    b.features.resize(m);
+    b.ms.resize(m);
+    b.sizes.resize(m);
     ParallelFor(m, threads, [&](int64_t i) {
       const Timer t;
       const cv::Mat image = load_image(poses.frames[start + i]);
-      sizes[i] = image.size();
-      features[i] = vision::ExtractOrb(image, orb);
-      ms[i] = t.ElapsedMs();
+      b.sizes[i] = image.size();
+      b.features[i] = vision::ExtractOrb(image, orb);
+      b.ms[i] = t.ElapsedMs();
     });
-    for (int64_t i = 0; i < m; ++i) {
+    return b;
+  };
+  // With two or more threads the next batch is extracted while this one is associated; the
+  // features do not depend on the association, so the map is the same either way.
+  const bool prefetch = threads >= 2;
+  std::future<Batch> pending;
+  if (prefetch && n > 0) pending = std::async(std::launch::async, extract, 0);
+  for (int64_t start = 0; start < n; start += batch) {
+    Batch b = prefetch ? pending.get() : extract(start);
+    if (prefetch && start + batch < n) {
+      pending = std::async(std::launch::async, extract, start + batch);
+    }
+    for (int64_t i = 0; i < static_cast<int64_t>(b.features.size()); ++i) {
       if (!builder) {
         PinholeCamera c = camera;
-        if (c.width <= 0 || c.height <= 0) c.width = sizes[i].width, c.height = sizes[i].height;
-        builder = std::make_unique<VisualMapBuilder>(c, options);
+        if (c.width <= 0 || c.height <= 0) c.width = b.sizes[i].width, c.height = b.sizes[i].height;
+        builder = std::make_unique<VisualMapBuilder>(c, options, threads);
       }
       const int64_t frame = poses.frames[start + i];
       const bool dir = std::binary_search(directions.begin(), directions.end(), frame);
       result.frames.push_back(
-          builder->AddFrame(frame, poses.world_from_cam[start + i], std::move(features[i]), dir));
-      result.orb_ms.push_back(ms[i]);
+          builder->AddFrame(frame, poses.world_from_cam[start + i], std::move(b.features[i]), dir));
+      result.orb_ms.push_back(b.ms[i]);
       if (on_frame) on_frame(result.frames.back());
     }
   }

@@ -98,7 +98,9 @@ struct FrameReport {
 
 class VisualMapBuilder {
  public:
-  VisualMapBuilder(const PinholeCamera& camera, const VisualMapOptions& options);
+  // `threads`: the patch alignments of one step (a keyframe's tracked keypoints, the fused
+  // matches in one neighbour) run in parallel; the result does not depend on it.
+  VisualMapBuilder(const PinholeCamera& camera, const VisualMapOptions& options, int threads = 1);
   // Frames must come in increasing frame order.
   FrameReport AddFrame(int64_t frame, const Rigid3d& world_from_cam, vision::OrbFeatures features,
                        bool has_direction);
@@ -132,8 +134,21 @@ class VisualMapBuilder {
   // alignment failed (the keypoint is left as detected), true if it moved or alignment is off or
   // not possible (no reference patch or level images).
   bool AlignKeypoint(int point, int keyframe, int keypoint);
+  // AlignKeypoint in two steps, so that the alignments of distinct points can be computed in
+  // parallel and applied in order.
+  struct Alignment {
+    bool ok = true;      // false: the alignment failed
+    bool moved = false;  // uv holds the aligned keypoint position
+    Eigen::Vector2f uv = Eigen::Vector2f::Zero();
+  };
+  Alignment ComputeAlignment(int point, int keyframe, int keypoint) const;
+  bool ApplyAlignment(const Alignment& a, int keyframe, int keypoint);
+  // ComputeAlignment of each (point, keypoint) pair in `keyframe`, on threads_ threads.
+  std::vector<Alignment> ComputeAlignments(const std::vector<std::pair<int, int>>& pairs,
+                                           int keyframe) const;
 
   VisualMapOptions options_;
+  int threads_ = 1;
   VisualMap map_;
   std::vector<int> recent_points_;  // Created within the last keyframes; subject to culling.
   int64_t last_frame_ = -1;

@@ -1,7 +1,10 @@
 // New map points of a keyframe (ORB-SLAM2 LocalMapping::CreateNewMapPoints, SearchInNeighbors
 // and MapPointCulling), with the prior poses in place of the optimised ones.
 #include <algorithm>
+#include <utility>
+#include <vector>
 
+#include "core/threads.h"
 #include "mapping/visual/map_builder.h"
 
 namespace jvl::mapping {
@@ -53,6 +56,10 @@ int VisualMapBuilder::CreateNewPoints(int keyframe) {
     const auto pairs =
         vision::MatchEpipolar(map_.camera, kf.features, kf.cam_from_world, Used(kf), nb.features,
                               nb.cam_from_world, Used(nb), map_.level_scales, options_.epipolar);
+    // The points of this neighbour are triangulated first, their keypoints in the neighbour
+    // aligned in parallel (each alignment reads its own point only), then inserted in order.
+    std::vector<std::pair<int, int>> created_pairs;  // (point, keypoint in the neighbour)
+    std::vector<int> keypoint_in_kf;
     for (const auto& [i, j] : pairs) {
       const vision::OrbKeypoint& a = kf.features.keypoints[i];
       const vision::OrbKeypoint& b = nb.features.keypoints[j];
@@ -67,7 +74,14 @@ int VisualMapBuilder::CreateNewPoints(int keyframe) {
       map_.points.push_back(point);
       const int p = static_cast<int>(map_.points.size()) - 1;
       SetPatch(p, keyframe, i);
-      if (!AlignKeypoint(p, neighbours[n], j) && options_.require_alignment) {
+      created_pairs.emplace_back(p, j);
+      keypoint_in_kf.push_back(i);
+    }
+    const std::vector<Alignment> aligned = ComputeAlignments(created_pairs, neighbours[n]);
+    for (size_t c = 0; c < created_pairs.size(); ++c) {
+      const auto [p, j] = created_pairs[c];
+      const int i = keypoint_in_kf[c];
+      if (!ApplyAlignment(aligned[c], neighbours[n], j) && options_.require_alignment) {
         map_.points[p].bad = true;
         continue;
       }
@@ -107,18 +121,22 @@ int VisualMapBuilder::FusePoints(int keyframe, const std::vector<int>& new_point
     const vision::KeypointGrid grid(nb.features.keypoints, map_.camera.width, map_.camera.height);
     const std::vector<int> match = vision::MatchByProjection(
         projected, nb.features, grid, map_.level_scales, options_.projection, Used(nb));
+    std::vector<std::pair<int, int>> pairs;  // (point, keypoint); one keypoint per point
     for (size_t i = 0; i < match.size(); ++i) {
-      if (match[i] < 0) continue;
-      const int p = predicted[i];
-      if (!AlignKeypoint(p, k, match[i]) && options_.require_alignment) continue;
-      const vision::OrbKeypoint& kp = nb.features.keypoints[match[i]];
+      if (match[i] >= 0) pairs.emplace_back(predicted[i], match[i]);
+    }
+    const std::vector<Alignment> aligned = ComputeAlignments(pairs, k);
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      const auto [p, keypoint] = pairs[i];
+      if (!ApplyAlignment(aligned[i], k, keypoint) && options_.require_alignment) continue;
+      const vision::OrbKeypoint& kp = nb.features.keypoints[keypoint];
       const double s = map_.level_scales[kp.octave];
       if (vision::SquaredReprojectionError(map_.camera, nb.cam_from_world, map_.points[p].position,
                                            kp.uv.cast<double>()) >
           options_.triangulation.max_reprojection_chi2 * s * s) {
         continue;
       }
-      AddObservation(&map_, p, k, match[i]);
+      AddObservation(&map_, p, k, keypoint);
       touched.push_back(p);
       ++fused;
     }
@@ -147,11 +165,13 @@ void VisualMapBuilder::SetPatch(int point, int keyframe, int keypoint) {
   p.patch_octave = kp.octave;
 }
 
-bool VisualMapBuilder::AlignKeypoint(int point, int keyframe, int keypoint) {
+VisualMapBuilder::Alignment VisualMapBuilder::ComputeAlignment(int point, int keyframe,
+                                                               int keypoint) const {
+  Alignment out;
   const MapPoint& p = map_.points[point];
-  Keyframe& kf = map_.keyframes[keyframe];
-  if (!options_.align_patches || !p.patch.valid || kf.features.pyramid.empty()) return true;
-  vision::OrbKeypoint& kp = kf.features.keypoints[keypoint];
+  const Keyframe& kf = map_.keyframes[keyframe];
+  if (!options_.align_patches || !p.patch.valid || kf.features.pyramid.empty()) return out;
+  const vision::OrbKeypoint& kp = kf.features.keypoints[keypoint];
   const cv::Mat& level = kf.features.pyramid[kp.octave];
   const cv::Size image = kf.features.pyramid[0].size();
   // A patch pixel of the reference level, in pixels of this keypoint's level.
@@ -163,9 +183,30 @@ bool VisualMapBuilder::AlignKeypoint(int point, int keyframe, int keypoint) {
   const vision::PatchAlignment a = vision::AlignPatch(
       level, p.patch, vision::ImageToLevel(kp.uv.cast<double>(), level.size(), image), scale,
       options_.align);
-  if (!a.ok) return false;
-  kp.uv = vision::LevelToImage(a.level_xy, level.size(), image).cast<float>();
-  return true;
+  out.ok = a.ok;
+  if (!a.ok) return out;
+  out.moved = true;
+  out.uv = vision::LevelToImage(a.level_xy, level.size(), image).cast<float>();
+  return out;
+}
+
+bool VisualMapBuilder::ApplyAlignment(const Alignment& a, int keyframe, int keypoint) {
+  if (a.moved) map_.keyframes[keyframe].features.keypoints[keypoint].uv = a.uv;
+  return a.ok;
+}
+
+bool VisualMapBuilder::AlignKeypoint(int point, int keyframe, int keypoint) {
+  return ApplyAlignment(ComputeAlignment(point, keyframe, keypoint), keyframe, keypoint);
+}
+
+std::vector<VisualMapBuilder::Alignment> VisualMapBuilder::ComputeAlignments(
+    const std::vector<std::pair<int, int>>& pairs, int keyframe) const {
+  std::vector<Alignment> out(pairs.size());
+  // Each alignment reads its own point and keypoint only, so the order does not matter.
+  ParallelFor(static_cast<int64_t>(pairs.size()), threads_, [&](int64_t i) {
+    out[i] = ComputeAlignment(pairs[i].first, keyframe, pairs[i].second);
+  });
+  return out;
 }
 
 int VisualMapBuilder::RefineAndCheck(int point) {
