@@ -36,7 +36,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PHASES = ("common", "config", "reweight")
 # Makefile.example variables, in the order they are written to a job line.
 SEQUENCE_VARS = ("DATASET", "GT", "PRIOR", "ODOM_N")  # fixed per sequence (common phase)
-UPSTREAM_VARS = ("N", "V_INTERVAL", "VISUAL_OPTS")  # change direction_cluster / visual_assoc / local_map
+# change direction_cluster / visual_assoc / local_map
+UPSTREAM_VARS = ("N", "V_INTERVAL", "VISUAL_OPTS", "LOCAL_OPTS")
 # global_opt + evaluate (and the re-association passes p > 1, which live in the task's own folder)
 REWEIGHT_VARS = ("ALPHA", "BETA", "GAMMA", "GLOBAL_OPTS", "ALIGN", "PASSES", "LOOPS")
 OTHER_VARS = ("THREADS", "BIN")

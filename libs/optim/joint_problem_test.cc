@@ -159,8 +159,25 @@ TEST(JointProblem, DropsObservationsBehindTheCameraAndFixesTheFirstPoseByDefault
   EXPECT_TRUE(jp.problem->IsParameterBlockConstant(jp.poses.at(0).data()));
   EXPECT_FALSE(jp.problem->IsParameterBlockConstant(jp.poses.at(1).data()));
   const JointSolveResult result = SolveJointProblem(jp, {});
-  EXPECT_EQ(result.linear_solver, "SPARSE_SCHUR");
+  EXPECT_EQ(result.linear_solver, "DENSE_SCHUR");  // a handful of poses
   EXPECT_TRUE(result.usable);
+}
+
+TEST(JointProblem, DenseAndSparseSchurComplementsGiveTheSameSolution) {
+  ToyRoad toy = MakeToyRoad(false);
+  SolveOptions dense, sparse;
+  sparse.dense_schur_max_blocks = 0;
+  const JointSolveResult a = OptimizeJoint(toy.input, {}, dense);
+  const JointSolveResult b = OptimizeJoint(toy.input, {}, sparse);
+  EXPECT_EQ(a.linear_solver, "DENSE_SCHUR");
+  EXPECT_EQ(b.linear_solver, "SPARSE_SCHUR");
+  ASSERT_TRUE(a.usable && b.usable);
+  EXPECT_NEAR(a.after.total, b.after.total, 1e-9 * (1 + b.after.total));
+  for (const auto& [id, pose] : b.poses) {
+    EXPECT_LT((a.poses.at(id).translation() - pose.translation()).norm(), 1e-7) << id;
+  }
+  sparse.dense_schur_max_blocks = -1;
+  EXPECT_THROW(OptimizeJoint(toy.input, {}, sparse), Error);
 }
 
 TEST(JointProblem, VisualGateLeavesOutOutliersAndPointsWithoutDepth) {
@@ -275,9 +292,14 @@ TEST(JointProblem, CostsBeforeAndAfterAreEvaluatedOnlyWhenAsked) {
   solve.evaluate_before = false;
   solve.evaluate_after = false;
   const JointSolveResult none = OptimizeJoint(toy.input, {}, solve);
-  EXPECT_EQ(none.before.visual.count, 0);
-  EXPECT_EQ(none.after.visual.count, 0);
-  EXPECT_EQ(none.before.total, 0.0);
+  // Not evaluated: the counts, and Ceres' total cost before and after the solve.
+  EXPECT_EQ(none.before.visual.count, both.before.visual.count);
+  EXPECT_EQ(none.after.imls.count, both.after.imls.count);
+  EXPECT_EQ(none.before.visual.cost, 0.0);
+  EXPECT_EQ(none.after.visual.rms, 0.0);
+  EXPECT_NEAR(none.before.total, both.before.total, 1e-9 * both.before.total);
+  EXPECT_NEAR(none.after.total, both.after.total, 1e-9 * both.before.total);
+  EXPECT_LT(none.after.total, none.before.total);
   // Same solve either way.
   for (const auto& [id, pose] : both.poses)
     EXPECT_EQ(pose.translation(), none.poses.at(id).translation());

@@ -67,7 +67,13 @@ ceres::Solver::Options MakeSolverOptions(JointProblem& jp, const SolveOptions& o
   // was assembled in a different order from run to run and results differed in the last bits.
   // One group per pose, in keyframe-id order, makes the order that of the ids (the points are
   // one contiguous array, so their address order is their index order).
-  so.linear_solver_type = ceres::SPARSE_SCHUR;
+  int free_blocks = 0;
+  for (auto& [id, block] : jp.poses) {
+    free_blocks += jp.problem->IsParameterBlockConstant(block.data()) ? 0 : 1;
+  }
+  free_blocks += static_cast<int>(jp.free_directions.size());
+  so.linear_solver_type =
+      free_blocks <= options.dense_schur_max_blocks ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (auto& point : jp.map_points) {
     if (jp.problem->HasParameterBlock(point.data())) ordering->AddElementToGroup(point.data(), 0);
@@ -101,7 +107,23 @@ void SolveOptions::Check() const {
   JVL_CHECK(function_tolerance >= 0 && gradient_tolerance >= 0 && parameter_tolerance >= 0,
             "solver tolerances must be non-negative");
   JVL_CHECK(max_time_s > 0, "max_time_s must be positive");
+  JVL_CHECK(dense_schur_max_blocks >= 0,
+            "dense_schur_max_blocks must be >= 0 (got " << dense_schur_max_blocks << ")");
 }
+
+namespace {
+
+// The residual counts of each term without evaluating anything; `total` is left to the caller.
+JointCostBreakdown CountResiduals(const JointProblem& jp) {
+  JointCostBreakdown b;
+  b.visual.count = static_cast<int64_t>(jp.visual_blocks.size());
+  for (int64_t c : jp.imls_block_counts) b.imls.count += c;
+  b.direction.count = static_cast<int64_t>(jp.direction_blocks.size());
+  b.relative.count = static_cast<int64_t>(jp.relative_blocks.size());
+  return b;
+}
+
+}  // namespace
 
 JointCostBreakdown EvaluateJointCost(JointProblem& jp) {
   JointCostBreakdown b;
@@ -129,7 +151,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   result.gated_points = jp.gated_points;
   result.weak_points = jp.weak_points;
   Timer phase;
-  if (options.evaluate_before) result.before = EvaluateJointCost(jp);
+  result.before = options.evaluate_before ? EvaluateJointCost(jp) : CountResiduals(jp);
   const double before_s = phase.ElapsedSeconds();
   ceres::Solver::Options so = MakeSolverOptions(jp, options);
   ProgressLog progress(options.progress_label);
@@ -140,13 +162,19 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
     result.iterations = static_cast<int>(summary.iterations.size()) - 1;
     result.usable = summary.IsSolutionUsable();
     result.termination = summary.BriefReport();
+    if (!options.evaluate_before) result.before.total = summary.initial_cost;
   } else {
     result.usable = true;
     result.termination = "no residuals";
   }
   result.linear_solver = ceres::LinearSolverTypeToString(so.linear_solver_type);
   phase.Reset();
-  if (options.evaluate_after || !result.usable) result.after = EvaluateJointCost(jp);
+  if (options.evaluate_after || !result.usable) {
+    result.after = EvaluateJointCost(jp);
+  } else {
+    result.after = CountResiduals(jp);
+    result.after.total = jp.problem->NumResidualBlocks() > 0 ? summary.final_cost : 0.0;
+  }
   spdlog::debug(
       "joint solve: cost by term {:.1f} s before, {:.1f} s after; Ceres preprocessor {:.1f} s, "
       "minimizer {:.1f} s (Jacobians {:.1f} s, residuals {:.1f} s, linear solver {:.1f} s), "

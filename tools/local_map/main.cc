@@ -98,10 +98,12 @@ int main(int argc, char** argv) {
         [&](size_t, const mapping::KeyframeStats& s) {
           spdlog::debug(
               "keyframe {}: local {}, model {}, fixed {}, visual {}, imls {} ({} new, {} "
-              "reused), cost {:.1f} -> {:.1f}, moved {:.3f} m, {:.0f} ms",
+              "reused), cost {:.1f} -> {:.1f} in {} iterations, moved {:.3f} m, {:.0f} ms ({:.0f} "
+              "ms "
+              "scan, {:.0f} ms association)",
               s.frame, s.local_keyframes, s.model_keyframes, s.fixed_keyframes, s.visual_residuals,
               s.imls_residuals, s.new_correspondences, s.reused_correspondences, s.cost_before,
-              s.cost_after, s.correction_m, s.time_ms);
+              s.cost_after, s.iterations, s.correction_m, s.time_ms, s.scan_ms, s.associate_ms);
           progress.Tick();
         });
     const nlohmann::json summary = mapping::SummarizeLocalMap(result, options);

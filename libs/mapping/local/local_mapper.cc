@@ -2,8 +2,13 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <functional>
+#include <future>
 #include <map>
 #include <memory>
+#include <set>
+#include <utility>
+#include <vector>
 
 #include "core/check.h"
 #include "core/timer.h"
@@ -17,6 +22,9 @@ class LocalMapper {
   LocalMapper(const LocalMappingInput& input, const LocalMappingOptions& options, int threads)
       : in_(input), options_(options) {
     options_.solve.threads = std::max(1, threads);
+    // The keyframe statistics need only the total cost, which Ceres reports.
+    options_.solve.evaluate_before = false;
+    options_.solve.evaluate_after = false;
     adjacency_ = CovisibilityAdjacency(in_.size(), in_.covisibility);
     observations_of_.resize(in_.size());
     first_observer_.assign(in_.map_points.size(), in_.size());
@@ -30,9 +38,11 @@ class LocalMapper {
     result_.map_points = in_.map_points;
     result_.scans.resize(in_.size());
     point_placed_.assign(in_.map_points.size(), 0);
+    saved_range_.assign(in_.size(), {0, 0});
   }
 
-  KeyframeStats Process(size_t n, const ScanLoader& load_scan);
+  // `get_scan` returns keyframe n's prepared scan (loaded now or taken from a prefetch).
+  KeyframeStats Process(size_t n, const std::function<KeyframeScan()>& get_scan);
   LocalMappingResult Take() {
     // Points no optimisation touched still follow the correction of their first observer.
     for (size_t m = 0; m < point_placed_.size(); ++m) {
@@ -60,6 +70,8 @@ class LocalMapper {
   std::vector<size_t> first_observer_;                // Map point -> first observing keyframe.
   std::vector<uint8_t> point_placed_;
   std::map<size_t, KeyframeScan> scans_;  // Rows that may still enter S_model.
+  // Keyframe row -> [begin, end) of its own correspondences in result_.correspondences (L).
+  std::vector<std::pair<size_t, size_t>> saved_range_;
   LocalMappingResult result_;
 };
 
@@ -100,9 +112,17 @@ LocalMapper::Problem LocalMapper::BuildProblem(
     in.imls.push_back(l);
   }
   // ... and the saved ones within K_local are reused (supplement Eq. 1).
-  for (const size_t i : ReusableCorrespondences(result_.correspondences, local_set)) {
-    in.imls.push_back(result_.correspondences[i]);
-    ++p.reused;
+  // (ReusableCorrespondences over the keyframes' own ranges of L, in the same order: a scan of
+  // the whole of L grew with the drive.)
+  for (const int64_t r : local_set) {
+    const auto [begin, end] = saved_range_[static_cast<size_t>(r)];
+    for (size_t i = begin; i < end; ++i) {
+      const optim::ImlsCorrespondence& l = result_.correspondences[i];
+      if (local_set.count(l.c)) {
+        in.imls.push_back(l);
+        ++p.reused;
+      }
+    }
   }
   // Step 1: every observation of a K_local keyframe, points seen often enough among them.
   std::map<int32_t, int> count;
@@ -158,7 +178,7 @@ bool LocalMapper::Solve(Problem& p, KeyframeStats* stats, bool first_round) {
   return true;
 }
 
-KeyframeStats LocalMapper::Process(size_t n, const ScanLoader& load_scan) {
+KeyframeStats LocalMapper::Process(size_t n, const std::function<KeyframeScan()>& get_scan) {
   const Timer timer;
   KeyframeStats stats;
   stats.frame = in_.frames[n];
@@ -167,7 +187,7 @@ KeyframeStats LocalMapper::Process(size_t n, const ScanLoader& load_scan) {
     result_.poses[n] = result_.poses[n - 1] * (in_.prior[n - 1].Inverse() * in_.prior[n]);
   }
   const Rigid3d initial = result_.poses[n];
-  scans_[n] = load_scan(n);
+  scans_[n] = get_scan();
   result_.scans[n] = scans_[n].stored;
   stats.scan_ms = timer.ElapsedMs();
 
@@ -178,7 +198,9 @@ KeyframeStats LocalMapper::Process(size_t n, const ScanLoader& load_scan) {
   stats.model_keyframes = static_cast<int>(n - start);
   std::vector<optim::ImlsCorrespondence> fresh;
   for (int round = 0; round < options_.association_rounds; ++round) {
+    const Timer associate;
     fresh = Associate(n, start);
+    stats.associate_ms += associate.ElapsedMs();
     Problem p = BuildProblem(local, fresh);
     stats.new_correspondences = static_cast<int>(fresh.size());
     stats.reused_correspondences = p.reused;
@@ -189,7 +211,13 @@ KeyframeStats LocalMapper::Process(size_t n, const ScanLoader& load_scan) {
     if (!solved) break;
   }
   // Step 4: save K_n's correspondences in L for later keyframes.
+  const size_t begin = result_.correspondences.size();
+  for (const auto& l : fresh) {
+    JVL_CHECK(l.n == static_cast<int64_t>(n),
+              "correspondence of keyframe " << l.n << " saved as " << n << "'s");
+  }
   result_.correspondences.insert(result_.correspondences.end(), fresh.begin(), fresh.end());
+  saved_range_[n] = {begin, result_.correspondences.size()};
   // Later keyframes start their S_model at or after `start`.
   while (!scans_.empty() && scans_.begin()->first < start) scans_.erase(scans_.begin());
   stats.correction_m = (result_.poses[n].translation() - initial.translation()).norm();
@@ -207,8 +235,24 @@ LocalMappingResult RunLocalMapping(const LocalMappingInput& input, const ScanLoa
   options.Check();
   LocalMapper mapper(input, options, threads);
   std::vector<KeyframeStats> stats;
+  // With two or more threads, keyframe n+1's scan is read and prepared while keyframe n is
+  // associated and solved (Ceres runs on one thread). The preparation depends only on the
+  // dataset and the prior, so the result is the same as without the prefetch; the loader is
+  // never called by two threads at once.
+  const bool prefetch = threads >= 2;
+  std::future<KeyframeScan> pending;
+  const auto launch = [&](size_t row) {
+    pending = std::async(std::launch::async, [&load_scan, row] { return load_scan(row); });
+  };
+  if (prefetch && input.size() > 0) launch(0);
   for (size_t n = 0; n < input.size(); ++n) {
-    stats.push_back(mapper.Process(n, load_scan));
+    const auto get_scan = [&]() -> KeyframeScan {
+      if (!prefetch) return load_scan(n);
+      KeyframeScan scan = pending.get();
+      if (n + 1 < input.size()) launch(n + 1);
+      return scan;
+    };
+    stats.push_back(mapper.Process(n, get_scan));
     if (on_keyframe) on_keyframe(n, stats.back());
   }
   LocalMappingResult result = mapper.Take();

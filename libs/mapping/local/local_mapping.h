@@ -77,7 +77,9 @@ struct KeyframeStats {
   bool optimized = false;   // A solve ran and was usable.
   double correction_m = 0;  // |t| of K_n's pose change by this keyframe's optimisation.
   double time_ms = 0;       // Whole keyframe including its scan preparation.
-  double scan_ms = 0, solve_ms = 0;
+  // scan_ms: preparing the scan, or with a prefetch (threads >= 2) waiting for it; solve_ms:
+  // association, problem and solve, of which associate_ms the scan association.
+  double scan_ms = 0, solve_ms = 0, associate_ms = 0;
 };
 
 struct LocalMappingResult {

@@ -15,7 +15,6 @@ double Quantile(const std::vector<T>& items, double q, F&& get) {
   return v.empty() ? 0.0 : jvl::Quantile(std::move(v), q);
 }
 
-
 }  // namespace
 
 Trajectory RefinedKeyframes(const LocalMappingInput& input, const LocalMappingResult& result) {
@@ -41,7 +40,11 @@ nlohmann::json SummarizeLocalMap(const LocalMappingResult& result,
       {"p95_time_ms", Quantile(s, 0.95, [](const KeyframeStats& k) { return k.time_ms; })},
       {"median_scan_ms", Quantile(s, 0.5, [](const KeyframeStats& k) { return k.scan_ms; })},
       {"median_solve_ms", Quantile(s, 0.5, [](const KeyframeStats& k) { return k.solve_ms; })},
+      {"median_associate_ms",
+       Quantile(s, 0.5, [](const KeyframeStats& k) { return k.associate_ms; })},
       {"total_time_s", total_ms / 1000.0},
+      {"median_iterations", Quantile(s, 0.5, [](const KeyframeStats& k) { return k.iterations; })},
+      {"p95_iterations", Quantile(s, 0.95, [](const KeyframeStats& k) { return k.iterations; })},
       {"median_local_keyframes",
        Quantile(s, 0.5, [](const KeyframeStats& k) { return k.local_keyframes; })},
       {"median_visual_residuals",
