@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <ctime>
+#include <future>
 #include <string>
 
 #include "app/tool.h"
@@ -61,10 +62,23 @@ int main(int argc, char** argv) {
     const auto& ids = dataset->frames();
     const std::clock_t cpu_start = std::clock();
     jvl::Progress progress("lidar_odom", static_cast<int64_t>(ids.size()), !tool.quiet());
-    for (size_t k = 0; k < ids.size(); ++k) {
+    // With two or more threads the next scan is read while this one is registered.
+    struct Loaded {
+      jvl::PointCloud scan;
       size_t dropped = 0;
-      const jvl::PointCloud scan = dataset->LoadScan(ids[k], &dropped);
-      const auto f = odometry.ProcessScan(scan, ids[k], static_cast<int64_t>(dropped),
+    };
+    const auto load = [&](size_t k) {
+      Loaded l;
+      l.scan = dataset->LoadScan(ids[k], &l.dropped);
+      return l;
+    };
+    const bool prefetch = tool.threads() >= 2;
+    std::future<Loaded> pending;
+    if (prefetch && !ids.empty()) pending = std::async(std::launch::async, load, 0);
+    for (size_t k = 0; k < ids.size(); ++k) {
+      const Loaded loaded = prefetch ? pending.get() : load(k);
+      if (prefetch && k + 1 < ids.size()) pending = std::async(std::launch::async, load, k + 1);
+      const auto f = odometry.ProcessScan(loaded.scan, ids[k], static_cast<int64_t>(loaded.dropped),
                                           dataset->ScanTimeOffsetInFrames(k));
       const auto& stamps = dataset->timestamps();
       AppendFrame(f, k < stamps.size() ? stamps[k] : static_cast<double>(ids[k]), &artifact);
