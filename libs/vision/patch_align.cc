@@ -21,17 +21,6 @@ bool Sample(const cv::Mat& img, double x, double y, float* value, float* gx, flo
   return true;
 }
 
-// h += j j^T (upper triangle; the lower one is filled once per iteration) and g += j r over the
-// first NP entries: the products and sums of the full outer product, in the same order.
-template <int NP>
-void AccumulateUpper(const double* j, double r, Eigen::Matrix<double, 8, 8>* h,
-                     Eigen::Matrix<double, 8, 1>* g) {
-  for (int row = 0; row < NP; ++row) {
-    for (int col = row; col < NP; ++col) (*h)(row, col) += j[row] * j[col];
-    (*g)(row) += j[row] * r;
-  }
-}
-
 double Ncc(const float* a, const float* b, int n) {
   double ma = 0, mb = 0;
   for (int i = 0; i < n; ++i) ma += a[i], mb += b[i];
@@ -100,16 +89,17 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
           current[i] = v;
           const double t = patch.values[i];
           const double r = v - a * t - b;
-          const double j[8] = {gx, gy, -t, -1.0, gx * dx, gx * dy, gy * dx, gy * dy};
-          // The warp's rows and columns are not used in stage 0.
-          if (np == 4) {
-            AccumulateUpper<4>(j, r, &h, &g);
+          Eigen::Matrix<double, 8, 1> j;
+          j << gx, gy, -t, -1.0, gx * dx, gx * dy, gy * dx, gy * dy;
+          if (np == 4) {  // The warp's rows and columns are not used in this stage.
+            h.topLeftCorner<4, 4>() += j.head<4>() * j.head<4>().transpose();
+            g.head<4>() += j.head<4>() * r;
           } else {
-            AccumulateUpper<8>(j, r, &h, &g);
+            h += j * j.transpose();
+            g += j * r;
           }
         }
       }
-      h.triangularView<Eigen::StrictlyLower>() = h.transpose();
       if (stage == 0 && it == 0) {
         // Start from the brightness change that matches means and spreads.
         double mt = 0, mv = 0, st = 0, sv = 0;
@@ -124,11 +114,11 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
         continue;
       }
       if (it == options.iterations) break;
-      Eigen::Matrix<double, 8, 1> d = Eigen::Matrix<double, 8, 1>::Zero();
+      Eigen::VectorXd d;
       if (np == 4) {
         Eigen::LDLT<Eigen::Matrix4d> ldlt(h.topLeftCorner<4, 4>());
         if (ldlt.info() != Eigen::Success) return out;
-        d.head<4>() = -ldlt.solve(g.head<4>());
+        d = -ldlt.solve(g.head<4>());
       } else {
         // A weak pull of the warp towards its prediction keeps it defined on edge-like patches.
         Eigen::Matrix<double, 8, 8> hr = h;
@@ -141,7 +131,7 @@ PatchAlignment AlignPatch(const cv::Mat& level, const PatchTemplate& patch,
         if (ldlt.info() != Eigen::Success) return out;
         d = -ldlt.solve(gr);
       }
-      if (!d.head(np).allFinite()) return out;
+      if (!d.allFinite()) return out;
       c += d.head<2>();
       a += d(2), b += d(3);
       if (np == 8) {
