@@ -130,12 +130,11 @@ class VisualMapBuilder {
   int RefineAndCheck(int point);  // map_points.cc
   // Takes the reference patch of a point from one of its keypoints (map_points.cc).
   void SetPatch(int point, int keyframe, int keypoint);
-  // Moves a keypoint to where the point's reference patch aligns (map_points.cc); false if the
-  // alignment failed (the keypoint is left as detected), true if it moved or alignment is off or
-  // not possible (no reference patch or level images).
-  bool AlignKeypoint(int point, int keyframe, int keypoint);
-  // AlignKeypoint in two steps, so that the alignments of distinct points can be computed in
-  // parallel and applied in order.
+  // Where a keypoint aligns with the point's reference patch (map_points.cc), computed without
+  // changing the map so that the alignments of distinct points can run in parallel;
+  // ApplyAlignment then moves the keypoint and returns false if the alignment failed (the
+  // keypoint is left as detected), true if it moved or alignment is off or not possible (no
+  // reference patch or level images).
   struct Alignment {
     bool ok = true;      // false: the alignment failed
     bool moved = false;  // uv holds the aligned keypoint position

@@ -195,10 +195,6 @@ bool VisualMapBuilder::ApplyAlignment(const Alignment& a, int keyframe, int keyp
   return a.ok;
 }
 
-bool VisualMapBuilder::AlignKeypoint(int point, int keyframe, int keypoint) {
-  return ApplyAlignment(ComputeAlignment(point, keyframe, keypoint), keyframe, keypoint);
-}
-
 std::vector<VisualMapBuilder::Alignment> VisualMapBuilder::ComputeAlignments(
     const std::vector<std::pair<int, int>>& pairs, int keyframe) const {
   std::vector<Alignment> out(pairs.size());
