@@ -126,15 +126,11 @@ JointCostBreakdown CountResiduals(const JointProblem& jp) {
 }  // namespace
 
 JointCostBreakdown EvaluateJointCost(JointProblem& jp) {
-  JointCostBreakdown b;
-  int64_t imls_count = 0;
-  for (int64_t c : jp.imls_block_counts) imls_count += c;
-  b.visual = Evaluate(*jp.problem, jp.visual_blocks, static_cast<int64_t>(jp.visual_blocks.size()));
-  b.imls = Evaluate(*jp.problem, jp.imls_blocks, imls_count);
-  b.direction =
-      Evaluate(*jp.problem, jp.direction_blocks, static_cast<int64_t>(jp.direction_blocks.size()));
-  b.relative =
-      Evaluate(*jp.problem, jp.relative_blocks, static_cast<int64_t>(jp.relative_blocks.size()));
+  JointCostBreakdown b = CountResiduals(jp);
+  b.visual = Evaluate(*jp.problem, jp.visual_blocks, b.visual.count);
+  b.imls = Evaluate(*jp.problem, jp.imls_blocks, b.imls.count);
+  b.direction = Evaluate(*jp.problem, jp.direction_blocks, b.direction.count);
+  b.relative = Evaluate(*jp.problem, jp.relative_blocks, b.relative.count);
   b.total = b.visual.cost + b.imls.cost + b.direction.cost + b.relative.cost;
   return b;
 }

@@ -112,17 +112,9 @@ LocalMapper::Problem LocalMapper::BuildProblem(
     in.imls.push_back(l);
   }
   // ... and the saved ones within K_local are reused (supplement Eq. 1).
-  // (ReusableCorrespondences over the keyframes' own ranges of L, in the same order: a scan of
-  // the whole of L grew with the drive.)
-  for (const int64_t r : local_set) {
-    const auto [begin, end] = saved_range_[static_cast<size_t>(r)];
-    for (size_t i = begin; i < end; ++i) {
-      const optim::ImlsCorrespondence& l = result_.correspondences[i];
-      if (local_set.count(l.c)) {
-        in.imls.push_back(l);
-        ++p.reused;
-      }
-    }
+  for (const size_t i : ReusableCorrespondences(result_.correspondences, saved_range_, local_set)) {
+    in.imls.push_back(result_.correspondences[i]);
+    ++p.reused;
   }
   // Step 1: every observation of a K_local keyframe, points seen often enough among them.
   std::map<int32_t, int> count;

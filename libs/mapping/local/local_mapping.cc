@@ -34,8 +34,7 @@ void LocalMappingOptions::Check() const {
   JVL_CHECK(scan_map_size >= 1, "scan_map_size must be >= 1, got " << scan_map_size);
   JVL_CHECK(min_model_keyframes >= 0,
             "min_model_keyframes must be >= 0, got " << min_model_keyframes);
-  JVL_CHECK(association_rounds >= 1,
-            "association_rounds must be >= 1, got " << association_rounds);
+  JVL_CHECK(association_rounds >= 1, "association_rounds must be >= 1, got " << association_rounds);
   JVL_CHECK(min_point_observations >= 1,
             "min_point_observations must be >= 1, got " << min_point_observations);
   association.Check();
@@ -81,10 +80,15 @@ std::vector<int64_t> LocalKeyframes(size_t n, const std::vector<std::vector<int>
 }
 
 std::vector<size_t> ReusableCorrespondences(const std::vector<optim::ImlsCorrespondence>& saved,
+                                            const std::vector<std::pair<size_t, size_t>>& ranges,
                                             const std::set<int64_t>& local) {
   std::vector<size_t> out;
-  for (size_t i = 0; i < saved.size(); ++i) {
-    if (local.count(saved[i].n) && local.count(saved[i].c)) out.push_back(i);
+  for (const int64_t r : local) {
+    if (r < 0 || static_cast<size_t>(r) >= ranges.size()) continue;
+    const auto [begin, end] = ranges[static_cast<size_t>(r)];
+    for (size_t i = begin; i < end; ++i) {
+      if (saved[i].n == r && local.count(saved[i].c)) out.push_back(i);
+    }
   }
   return out;
 }

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geometry/calibration.h"
@@ -101,7 +102,10 @@ std::vector<std::vector<int>> CovisibilityAdjacency(size_t num_keyframes,
                                                     const std::vector<std::array<int, 2>>& edges);
 
 // Supplement 1.2: indices of the saved correspondences whose keyframes n and c are both local.
+// `ranges[r]` is [begin, end) of keyframe r's own correspondences (n = r) in `saved`, so only
+// the local keyframes' ranges are visited (L grows with the drive); indices come by keyframe.
 std::vector<size_t> ReusableCorrespondences(const std::vector<optim::ImlsCorrespondence>& saved,
+                                            const std::vector<std::pair<size_t, size_t>>& ranges,
                                             const std::set<int64_t>& local);
 
 // Gauge (step 5): keyframe 0 and every pose outside K_local are fixed; if that leaves no fixed

@@ -69,9 +69,12 @@ TEST(LocalMapping, SavedCorrespondencesReusedOnlyWithinLocal) {
     saved[i].n = pairs[i][0];
     saved[i].c = pairs[i][1];
   }
-  EXPECT_EQ(ReusableCorrespondences(saved, {2, 3, 4}), (std::vector<size_t>{2, 3}));
-  EXPECT_EQ(ReusableCorrespondences(saved, {0, 1, 2}), (std::vector<size_t>{0, 1}));
-  EXPECT_TRUE(ReusableCorrespondences(saved, {4}).empty());  // Needs both keyframes.
+  // Keyframe r's own entries (n = r): none for 0, [0, 1) for 1, [1, 2) for 2, [4, 5) for 3,
+  // [2, 4) for 4.
+  const std::vector<std::pair<size_t, size_t>> ranges = {{0, 0}, {0, 1}, {1, 2}, {4, 5}, {2, 4}};
+  EXPECT_EQ(ReusableCorrespondences(saved, ranges, {2, 3, 4}), (std::vector<size_t>{2, 3}));
+  EXPECT_EQ(ReusableCorrespondences(saved, ranges, {0, 1, 2}), (std::vector<size_t>{0, 1}));
+  EXPECT_TRUE(ReusableCorrespondences(saved, ranges, {4}).empty());  // Needs both keyframes.
 }
 
 TEST(LocalMapping, GaugeFixesFirstKeyframeAndNonLocalPoses) {
