@@ -199,4 +199,57 @@ class RelativePoseCost {
   const Eigen::Vector3d sqrt_info_trans_;
 };
 
+// Vehicle-motion error e_M(a, b, c) of three consecutive keyframes (beyond the paper,
+// docs/global_opt.md "Motion term"): the change of the body-frame velocity per frame,
+//   v_ab = R_m(a,b)^T (t_wb - t_wa) / n_ab,   v_bc = R_m(b,c)^T (t_wc - t_wb) / n_bc,
+//   r = sqrt_info .* (v_bc - v_ab)   [3]
+// with n_ab, n_bc the frames between the keyframes and R_m(a,b) the rotation halfway between a's
+// and b's (R_wa sqrt(R_wa^T R_wb)): on a turn the chord of an interval points along the path's
+// tangent at its middle, so a car at constant speed and turn rate gives r = 0 for any spacing
+// of the keyframes (to (n theta)^2 / 24 of the speed). r is the acceleration per frame.
+class MotionSmoothnessCost {
+ public:
+  MotionSmoothnessCost(double frames_ab, double frames_bc, const Eigen::Vector3d& sqrt_info)
+      : inv_ab_(1.0 / frames_ab), inv_bc_(1.0 / frames_bc), sqrt_info_(sqrt_info) {}
+
+  template <typename T>
+  bool operator()(const T* world_from_a, const T* world_from_b, const T* world_from_c,
+                  T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wa(world_from_a);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wa(world_from_a + 4);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wb(world_from_b);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wb(world_from_b + 4);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wc(world_from_c);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wc(world_from_c + 4);
+    const Eigen::Matrix<T, 3, 1> v_ab =
+        Midway<T>(q_wa, q_wb).conjugate() * (t_wb - t_wa) * T(inv_ab_);
+    const Eigen::Matrix<T, 3, 1> v_bc =
+        Midway<T>(q_wb, q_wc).conjugate() * (t_wc - t_wb) * T(inv_bc_);
+    for (int k = 0; k < 3; ++k) residual[k] = T(sqrt_info_(k)) * (v_bc(k) - v_ab(k));
+    return true;
+  }
+
+  // q_1 sqrt(q_1^-1 q_2): the square root of a unit quaternion q (w >= 0) is (q + 1) / |q + 1|.
+  template <typename T>
+  static Eigen::Quaternion<T> Midway(const Eigen::Quaternion<T>& q_1,
+                                     const Eigen::Quaternion<T>& q_2) {
+    Eigen::Quaternion<T> d = q_1.conjugate() * q_2;
+    if (d.w() < T(0)) d.coeffs() = -d.coeffs();
+    d.w() += T(1);
+    d.normalize();
+    return q_1 * d;
+  }
+
+  static ceres::CostFunction* Create(double frames_ab, double frames_bc,
+                                     const Eigen::Vector3d& sqrt_info) {
+    return new ceres::AutoDiffCostFunction<MotionSmoothnessCost, 3, 7, 7, 7>(
+        new MotionSmoothnessCost(frames_ab, frames_bc, sqrt_info));
+  }
+
+ private:
+  const double inv_ab_;
+  const double inv_bc_;
+  const Eigen::Vector3d sqrt_info_;
+};
+
 }  // namespace jvl::optim

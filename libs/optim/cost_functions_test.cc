@@ -235,5 +235,67 @@ TEST(RelativePoseCost, InvariantToACommonRigidMotionOfBothPoses) {
   }
 }
 
+TEST(MotionSmoothnessCost, ZeroOnAConstantTurnKnownValueAndJacobianMatches) {
+  // A car on a circle at constant speed and turn rate: 1.2 m and 0.02 rad per frame (about the
+  // camera's y axis, down), keyframes 2 and 3 frames apart.
+  std::mt19937 rng(7);
+  const Rigid3d start = RandomPose(rng, 0.5, 20.0);
+  const double radius = 1.2 / 0.02;
+  auto on_circle = [&](double frames) {
+    const double phi = 0.02 * frames;
+    return start * Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitY())),
+                           radius * Eigen::Vector3d(1.0 - std::cos(phi), 0.0, std::sin(phi)));
+  };
+  const Eigen::Vector3d sigma(0.004, 0.003, 0.009);
+  std::unique_ptr<ceres::CostFunction> cost(
+      MotionSmoothnessCost::Create(2.0, 3.0, sigma.cwiseInverse()));
+  PoseBlock a = ToPoseBlock(on_circle(0)), b = ToPoseBlock(on_circle(2)),
+            c = ToPoseBlock(on_circle(5));
+  // The chords shrink by (n phi)^2 / 24 of the speed: 0.1 mm per frame between the two spacings.
+  std::vector<double> r = Residuals(*cost, {a.data(), b.data(), c.data()});
+  for (int k = 0; k < 3; ++k) EXPECT_LT(std::abs(r[k]) * sigma(k), 1.5e-4) << k;
+  // Expressed in a's frame instead of the midway one, the lateral part would be 12 mm per frame.
+
+  // c moved 0.03 m forward along the chord b -> c: v_bc grows by 0.01 m per frame along z.
+  const Rigid3d b_pose = on_circle(2), c_pose = on_circle(5);
+  const Eigen::Vector3d chord = (c_pose.translation() - b_pose.translation()).normalized();
+  const Rigid3d moved_c(c_pose.rotation(), c_pose.translation() + 0.03 * chord);
+  PoseBlock c_moved = ToPoseBlock(moved_c);
+  const std::vector<double> r0 = r;
+  r = Residuals(*cost, {a.data(), b.data(), c_moved.data()});
+  EXPECT_NEAR(r[0] - r0[0], 0.0, 1e-6);
+  EXPECT_NEAR(r[1] - r0[1], 0.0, 1e-6);
+  EXPECT_NEAR(r[2] - r0[2], 0.01 / 0.009, 1e-6);
+
+  std::string log;
+  EXPECT_LT(CheckGradient(*cost, {true, true, true}, {a.data(), b.data(), c_moved.data()}, &log),
+            1e-6)
+      << log;
+}
+
+TEST(MotionSmoothnessCost, InvariantToACommonRigidMotionAndBlindToAConstantVelocity) {
+  std::mt19937 rng(8);
+  const Rigid3d a_pose = RandomPose(rng, 0.5, 20.0);
+  const Rigid3d b_pose = a_pose * RandomPose(rng, 0.05, 2.0);
+  const Rigid3d c_pose = b_pose * RandomPose(rng, 0.05, 2.0);
+  std::unique_ptr<ceres::CostFunction> cost(
+      MotionSmoothnessCost::Create(1.0, 1.0, Eigen::Vector3d(200, 300, 100)));
+  PoseBlock a = ToPoseBlock(a_pose), b = ToPoseBlock(b_pose), c = ToPoseBlock(c_pose);
+  const std::vector<double> r0 = Residuals(*cost, {a.data(), b.data(), c.data()});
+  EXPECT_GT(std::abs(r0[0]) + std::abs(r0[1]) + std::abs(r0[2]), 1.0);  // not a constant motion
+  for (int trial = 0; trial < 5; ++trial) {
+    const Rigid3d g = RandomPose(rng, 1.0, 50.0);
+    PoseBlock ga = ToPoseBlock(g * a_pose), gb = ToPoseBlock(g * b_pose),
+              gc = ToPoseBlock(g * c_pose);
+    const std::vector<double> r = Residuals(*cost, {ga.data(), gb.data(), gc.data()});
+    for (size_t k = 0; k < r.size(); ++k) EXPECT_NEAR(r[k], r0[k], 1e-8);
+  }
+  // The same motion repeated (b = a * M, c = b * M) is a constant body-frame velocity: zero.
+  const Rigid3d step = RandomPose(rng, 0.05, 2.0);
+  PoseBlock b2 = ToPoseBlock(a_pose * step), c2 = ToPoseBlock(a_pose * step * step);
+  for (const double r : Residuals(*cost, {a.data(), b2.data(), c2.data()}))
+    EXPECT_NEAR(r, 0.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace jvl::optim

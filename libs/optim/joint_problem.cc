@@ -90,6 +90,18 @@ void CheckResiduals(const JointProblemInput& input) {
               "relative pose constraint (" << r.i << ", " << r.j
                                            << ") has a non-finite motion or a sigma <= 0");
   }
+  for (const MotionConstraint& m : input.motion) {
+    CheckKeyframe(input, m.a, "motion constraint");
+    CheckKeyframe(input, m.b, "motion constraint");
+    CheckKeyframe(input, m.c, "motion constraint");
+    JVL_CHECK(m.a != m.b && m.b != m.c && m.a != m.c, "motion constraint ("
+                                                          << m.a << ", " << m.b << ", " << m.c
+                                                          << ") needs three different keyframes");
+    JVL_CHECK(std::isfinite(m.frames_ab) && std::isfinite(m.frames_bc) && m.frames_ab > 0 &&
+                  m.frames_bc > 0 && m.sigma_m.allFinite() && m.sigma_m.minCoeff() > 0,
+              "motion constraint (" << m.a << ", " << m.b << ", " << m.c
+                                    << ") has a frame gap or a sigma <= 0");
+  }
   for (size_t i = 0; i < input.free_directions.size(); ++i)
     JVL_CHECK(Finite(input.free_directions[i]) && input.free_directions[i].norm() > 1e-9,
               "free direction " << i << " is not finite or zero");
@@ -279,6 +291,7 @@ void JointProblemOptions::Check() const {
             "direction_sigma_v_px must be >= 0 (0: as direction_sigma_px)");
   JVL_CHECK(direction_min_z > 0 && direction_min_z < 1, "direction_min_z must be in (0, 1)");
   JVL_CHECK(std::isfinite(relative_cauchy), "relative_cauchy must be finite");
+  JVL_CHECK(std::isfinite(motion_cauchy), "motion_cauchy must be finite");
   JVL_CHECK(std::isfinite(visual_gate_chi2), "visual_gate_chi2 must be finite");
   JVL_CHECK(std::isfinite(max_point_sigma_ratio), "max_point_sigma_ratio must be finite");
   JVL_CHECK(
@@ -366,6 +379,17 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
           RelativePoseCost::Create(r.i_from_j.rotation(), r.i_from_j.translation(),
                                    r.sigma_rad.cwiseInverse(), r.sigma_m.cwiseInverse()),
           relative_loss, jp.poses.at(r.i).data(), jp.poses.at(r.j).data()));
+    }
+  }
+
+  // e_M: whitened, weight 1, Cauchy kernel.
+  if (!input.motion.empty()) {
+    ceres::LossFunction* motion_loss =
+        options.motion_cauchy > 0 ? new ceres::CauchyLoss(options.motion_cauchy) : nullptr;
+    for (const MotionConstraint& m : input.motion) {
+      jp.motion_blocks.push_back(jp.problem->AddResidualBlock(
+          MotionSmoothnessCost::Create(m.frames_ab, m.frames_bc, m.sigma_m.cwiseInverse()),
+          motion_loss, jp.poses.at(m.a).data(), jp.poses.at(m.b).data(), jp.poses.at(m.c).data()));
     }
   }
 

@@ -79,6 +79,15 @@ struct RelativePoseConstraint {
   Eigen::Vector3d sigma_m = Eigen::Vector3d::Constant(1e-2);
 };
 
+// A vehicle-motion constraint on three consecutive keyframes a, b, c (e_M; beyond the paper,
+// docs/global_opt.md "Motion term"): their body-frame velocity per frame should not change by
+// more than the vehicle's acceleration allows, sigma per axis of a's frame (metres per frame).
+struct MotionConstraint {
+  int64_t a = 0, b = 0, c = 0;
+  double frames_ab = 1.0, frames_bc = 1.0;
+  Eigen::Vector3d sigma_m = Eigen::Vector3d::Constant(1e-2);
+};
+
 struct JointProblemInput {
   PinholeCamera camera;
   // The observing camera's offset from the poses' frame (camera 0): x_camera = x_cam0 + offset.
@@ -104,6 +113,7 @@ struct JointProblemInput {
   std::vector<DirectionConstraint> directions;
   std::vector<Eigen::Vector3d> free_directions;        // initial values of the free d_w blocks
   std::vector<RelativePoseConstraint> relative_poses;  // e_O (weight 1 on whitened residuals)
+  std::vector<MotionConstraint> motion;                // e_M (weight 1 on whitened residuals)
 };
 
 struct JointProblemOptions {
@@ -135,6 +145,9 @@ struct JointProblemOptions {
   // disagrees with the other terms by many sigmas (an odometry's registration step) loses its
   // pull instead of dragging the solution.
   double relative_cauchy = 3.0;
+  // Cauchy kernel of e_M on its whitened norm (<= 0: none): a real acceleration (braking, a
+  // turn's start) many sigmas out keeps a bounded cost.
+  double motion_cauchy = 3.0;
   // Outlier gate on e_V at the initial estimate (whitened squared reprojection error; <= 0: off).
   // Observations above it are left out of the problem, and with free map points so is every
   // point left with fewer than 2 observations (its depth would be unconstrained). ORB-SLAM's
@@ -179,7 +192,8 @@ struct JointProblem {
   std::vector<std::array<double, 3>> map_points;
   std::vector<std::array<double, 3>> free_directions;
   std::unique_ptr<ceres::Problem> problem;
-  std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks, relative_blocks;
+  std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks, relative_blocks,
+      motion_blocks;
   std::vector<int64_t> imls_block_counts;  // correspondences in each of imls_blocks
   std::set<int64_t> fixed;                 // effective constant poses (gauge)
   JointWeights weights;
@@ -231,7 +245,7 @@ struct ResidualStats {
 };
 
 struct JointCostBreakdown {
-  ResidualStats visual, imls, direction, relative;
+  ResidualStats visual, imls, direction, relative, motion;
   double total = 0.0;
 };
 

@@ -120,6 +120,7 @@ JointCostBreakdown CountResiduals(const JointProblem& jp) {
   for (int64_t c : jp.imls_block_counts) b.imls.count += c;
   b.direction.count = static_cast<int64_t>(jp.direction_blocks.size());
   b.relative.count = static_cast<int64_t>(jp.relative_blocks.size());
+  b.motion.count = static_cast<int64_t>(jp.motion_blocks.size());
   return b;
 }
 
@@ -131,7 +132,8 @@ JointCostBreakdown EvaluateJointCost(JointProblem& jp) {
   b.imls = Evaluate(*jp.problem, jp.imls_blocks, b.imls.count);
   b.direction = Evaluate(*jp.problem, jp.direction_blocks, b.direction.count);
   b.relative = Evaluate(*jp.problem, jp.relative_blocks, b.relative.count);
-  b.total = b.visual.cost + b.imls.cost + b.direction.cost + b.relative.cost;
+  b.motion = Evaluate(*jp.problem, jp.motion_blocks, b.motion.count);
+  b.total = b.visual.cost + b.imls.cost + b.direction.cost + b.relative.cost + b.motion.cost;
   return b;
 }
 

@@ -380,6 +380,10 @@ TEST_F(BadInputTest, TruncatedAndWrongArtifacts) {
               "--local " + In("local.h5") + " --visual " + Bad("empty_visual.h5") + dirs + " -o " +
                   Bad("x.h5"),
               "empty_visual.h5: not an HDF5 file");
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + In("visual.h5") + dirs +
+                  " --motion-sigma 4 0 9 -o " + Bad("x.h5"),
+              "--motion-sigma: '0' is not a sigma > 0 in mm");
   ExpectError("evaluate", "--gt " + kRun + "/data/poses/00.txt --est " + Bad("cut_prior.h5"),
               "cut_prior.h5: cannot open HDF5 file");
   ExpectError("make_prior", "-g " + Bad("empty_prior.h5") + " -o " + Bad("x.h5"),

@@ -1,5 +1,9 @@
 #include "cli_options.h"
 
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
 #include "app/option_group.h"
 
 namespace jvl::tools {
@@ -67,6 +71,27 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
              "solution (the odometry's steps; <= 0: keep all)");
   method.Add("--odometry-cauchy", o->joint.relative_cauchy,
              "Cauchy kernel scale of e_O on its whitened norm (<= 0: none)");
+  method.Flag("!--no-motion", o->use_motion,
+              "Leave out the motion term e_M (the car's acceleration between three consecutive "
+              "keyframes; beyond the paper; ablation)");
+  f->motion_sigma_mm = {1e3 * o->motion_sigma_m.x(), 1e3 * o->motion_sigma_m.y(),
+                        1e3 * o->motion_sigma_m.z()};
+  method
+      .Add("--motion-sigma", f->motion_sigma_mm,
+           "e_M's sigma: change of the body-frame velocity per frame, mm, camera x y z "
+           "(right, down, forward; default: the real KITTI ground truth of sequences 09/10)")
+      ->expected(3)
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            return end != v.c_str() && *end == '\0' && std::isfinite(x) && x > 0
+                       ? std::string()
+                       : "'" + v + "' is not a sigma > 0 in mm";
+          },
+          "MM>0"));
+  method.Add("--motion-cauchy", o->joint.motion_cauchy,
+             "Cauchy kernel scale of e_M on its whitened norm (<= 0: none)");
   method.Add("--direction-huber", o->joint.direction_huber,
              "Huber threshold of e_D in sigmas (<= 0: none)");
   method.Add("--visual-gate", o->joint.visual_gate_chi2,
@@ -97,6 +122,9 @@ void ApplyGlobalOptFlags(const GlobalOptFlags& f, mapping::GlobalMappingOptions*
                                                         : Source::kFree;
   o->use_saved_imls = !f.no_saved_imls;
   o->fresh_traversal = !f.no_fresh_imls;
+  if (f.motion_sigma_mm.size() == 3)
+    o->motion_sigma_m =
+        1e-3 * Eigen::Vector3d(f.motion_sigma_mm[0], f.motion_sigma_mm[1], f.motion_sigma_mm[2]);
 }
 
 }  // namespace jvl::tools

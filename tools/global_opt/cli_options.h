@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "app/tool.h"
 #include "mapping/global/global_mapping.h"
@@ -11,10 +12,11 @@ namespace jvl::tools {
 
 // Switches that map onto GlobalMappingOptions only after parsing.
 struct GlobalOptFlags {
-  bool no_direction = false;   // --no-direction: the ablation without e_D
-  bool no_saved_imls = false;  // --no-saved-imls
-  bool no_fresh_imls = false;  // --no-fresh-imls
-  std::string direction_source;  // free, refit or prior
+  bool no_direction = false;            // --no-direction: the ablation without e_D
+  bool no_saved_imls = false;           // --no-saved-imls
+  bool no_fresh_imls = false;           // --no-fresh-imls
+  std::string direction_source;         // free, refit or prior
+  std::vector<double> motion_sigma_mm;  // --motion-sigma X Y Z
 };
 
 void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* options,

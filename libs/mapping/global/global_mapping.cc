@@ -151,6 +151,8 @@ void GlobalMappingOptions::Check() const {
                 min_direction_sigma_px > 0,
             "direction_sigma_px must be finite and min_direction_sigma_px > 0");
   JVL_CHECK(std::isfinite(odometry_gate), "odometry_gate must be finite");
+  JVL_CHECK(motion_sigma_m.allFinite() && motion_sigma_m.minCoeff() > 0,
+            "motion_sigma_m must be finite and > 0");
   JVL_CHECK(
       std::isfinite(vertical_bias_deg) && vertical_bias_deg >= 0,
       "vertical_bias_deg must be >= 0 (0: sigma from the VPs' spread), got " << vertical_bias_deg);
@@ -465,6 +467,42 @@ void SetOdometryTerm(int round, const GlobalMapInput& input, const GlobalMapping
   if (!options.use_odometry || input.odometry.empty() || round < 1) return;
   if (!term->entered) EnterOdometry(result->keyframes, input.odometry, options, term, result);
   problem->relative_poses = term->constraints;
+}
+
+// e_M: every three consecutive keyframes (GlobalMappingOptions::use_motion).
+std::vector<optim::MotionConstraint> MotionConstraints(const Trajectory& keyframes,
+                                                       const GlobalMappingOptions& options) {
+  std::vector<optim::MotionConstraint> out;
+  if (!options.use_motion) return out;
+  for (size_t b = 1; b + 1 < keyframes.size(); ++b) {
+    optim::MotionConstraint m;
+    m.a = static_cast<int64_t>(b - 1);
+    m.b = static_cast<int64_t>(b);
+    m.c = static_cast<int64_t>(b + 1);
+    m.frames_ab = static_cast<double>(keyframes.frames[b] - keyframes.frames[b - 1]);
+    m.frames_bc = static_cast<double>(keyframes.frames[b + 1] - keyframes.frames[b]);
+    if (m.frames_ab <= 0 || m.frames_bc <= 0) continue;
+    m.sigma_m = options.motion_sigma_m * std::sqrt(0.5 * (m.frames_ab + m.frames_bc));
+    out.push_back(m);
+  }
+  return out;
+}
+
+// Triples of the final solution whose whitened e_M is above the kernel scale.
+int64_t CountMotionOutliers(const std::vector<optim::MotionConstraint>& motion,
+                            const Trajectory& keyframes, double cauchy) {
+  if (cauchy <= 0) return 0;
+  int64_t n = 0;
+  for (const auto& m : motion) {
+    const optim::MotionSmoothnessCost cost(m.frames_ab, m.frames_bc, m.sigma_m.cwiseInverse());
+    const optim::PoseBlock a = optim::ToPoseBlock(keyframes.world_from_cam[m.a]);
+    const optim::PoseBlock b = optim::ToPoseBlock(keyframes.world_from_cam[m.b]);
+    const optim::PoseBlock c = optim::ToPoseBlock(keyframes.world_from_cam[m.c]);
+    Eigen::Vector3d r;
+    cost(a.data(), b.data(), c.data(), r.data());
+    if (r.squaredNorm() > cauchy * cauchy) ++n;
+  }
+  return n;
 }
 
 // Pairs of the final solution whose whitened e_O is above the kernel scale.
@@ -837,6 +875,8 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   optim::JointProblemOptions joint = options.joint;  // direction sigma set once e_D enters
   DirectionTerm direction;
   OdometryTerm odometry;
+  problem.motion = MotionConstraints(result.keyframes, options);
+  result.motion_triples = static_cast<int64_t>(problem.motion.size());
   if (options.use_odometry && !input.odometry.empty() && terms.rounds < 2)
     spdlog::info("odometry term left out: it needs a second round (a fresh traversal)");
   optim::JointCostBreakdown before;  // Eq. (7) at the input poses
@@ -873,6 +913,11 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
   if (!odometry.constraints.empty())
     spdlog::info("odometry term: {} of {} keyframe pairs above the kernel scale (down-weighted)",
                  result.odometry_outliers, odometry.constraints.size());
+  result.motion_outliers =
+      CountMotionOutliers(problem.motion, result.keyframes, options.joint.motion_cauchy);
+  if (!problem.motion.empty())
+    spdlog::info("motion term: {} of {} keyframe triples above the kernel scale (down-weighted)",
+                 result.motion_outliers, problem.motion.size());
   result.total_time_s = total.ElapsedSeconds();
   return result;
 }
@@ -902,11 +947,9 @@ nlohmann::json FreeJson(const GlobalMappingResult& r) {
 }
 
 nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
-  return {{"visual", StatsOf(b.visual)},
-          {"imls", StatsOf(b.imls)},
-          {"direction", StatsOf(b.direction)},
-          {"odometry", StatsOf(b.relative)},
-          {"total", b.total}};
+  return {{"visual", StatsOf(b.visual)},       {"imls", StatsOf(b.imls)},
+          {"direction", StatsOf(b.direction)}, {"odometry", StatsOf(b.relative)},
+          {"motion", StatsOf(b.motion)},       {"total", b.total}};
 }
 
 }  // namespace
@@ -971,6 +1014,12 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
         {"sigma_m", VectorJson(r.odometry_sigma_m)},
         {"sigma_deg", VectorJson(r.odometry_sigma_deg)},
         {"cauchy", o.joint.relative_cauchy}}},
+      {"motion",
+       {{"enabled", o.use_motion},
+        {"triples", r.motion_triples},
+        {"outliers", r.motion_outliers},
+        {"sigma_m", VectorJson(o.motion_sigma_m)},
+        {"cauchy", o.joint.motion_cauchy}}},
       {"solver",
        {{"usable", s.usable},
         {"iterations", r.total_iterations},
