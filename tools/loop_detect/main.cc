@@ -29,6 +29,7 @@
 #include "loop/lidar_loops.h"
 #include "loop/visual_loops.h"
 #include "loop/vocabulary.h"
+#include "mapping/visual/visual_artifact.h"
 
 namespace {
 
@@ -263,11 +264,7 @@ int main(int argc, char** argv) {
                             << map.scale_factor << ", the visual detector uses "
                             << visual_options.orb.num_levels << " x "
                             << visual_options.orb.scale_factor);
-      for (size_t p = 0; p < map.num_keypoints(); ++p) {
-        const int64_t f = map.keyframes.frames[static_cast<size_t>(map.keypoint_keyframe[p])];
-        auto [it, added] = rows.emplace(f, std::make_pair(p, p + 1));
-        if (!added) it->second.second = p + 1;
-      }
+      rows = mapping::KeypointRowsByFrame(map);
       // Only the keypoints are needed.
       auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
       release(map.mappoint_position), release(map.mappoint_descriptor);
@@ -291,25 +288,13 @@ int main(int argc, char** argv) {
     if (use_visual) {
       std::atomic<int64_t> extracted{0};
       auto features_of = [&](int64_t f) {
-        vision::OrbFeatures out;
         const auto it = rows.find(f);
         if (it == rows.end()) {
           ++extracted;
           return vision::ExtractOrb(dataset->LoadImage(f, visual_options.camera),
                                     visual_options.orb);
         }
-        for (size_t p = it->second.first; p < it->second.second; ++p) {
-          vision::OrbKeypoint k;
-          k.uv = Eigen::Vector2f(map.keypoint_uv[2 * p], map.keypoint_uv[2 * p + 1]);
-          k.octave = map.keypoint_octave[p];
-          k.angle = map.keypoint_angle[p];
-          out.keypoints.push_back(k);
-          vision::Descriptor d;
-          std::copy_n(map.keypoint_descriptor.begin() + static_cast<std::ptrdiff_t>(32 * p), 32,
-                      d.begin());
-          out.descriptors.push_back(d);
-        }
-        return out;
+        return mapping::KeyframeFeatures(map, it->second.first, it->second.second);
       };
       Progress progress("visual keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
       const loop::LoopResult result =

@@ -141,6 +141,22 @@ TEST(VisualMapBuilder, SyntheticCorridorWithKnownPoses) {
   EXPECT_GE(stats.min_points_per_keyframe, 100);
   EXPECT_GT(stats.edges, 0);
   for (int w : data.covisibility_weight) EXPECT_GE(w, 15);
+
+  // Each keyframe's features come back from the artifact as they were extracted.
+  const auto rows = KeypointRowsByFrame(data);
+  ASSERT_EQ(rows.size(), map.keyframes.size());
+  for (const Keyframe& kf : map.keyframes) {
+    const auto [first, last] = rows.at(kf.frame);
+    const vision::OrbFeatures back = KeyframeFeatures(data, first, last);
+    ASSERT_EQ(back.keypoints.size(), kf.features.keypoints.size()) << "frame " << kf.frame;
+    for (size_t i = 0; i < back.keypoints.size(); ++i) {
+      EXPECT_EQ(back.keypoints[i].uv, kf.features.keypoints[i].uv);
+      EXPECT_EQ(back.keypoints[i].octave, kf.features.keypoints[i].octave);
+      EXPECT_EQ(back.keypoints[i].angle, kf.features.keypoints[i].angle);
+      EXPECT_EQ(back.descriptors[i], kf.features.descriptors[i]);
+    }
+  }
+  EXPECT_THROW(KeyframeFeatures(data, 0, data.num_keypoints() + 1), Error);
 }
 
 // Heading error (deg) of a pose against the truth.

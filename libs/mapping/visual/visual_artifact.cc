@@ -138,6 +138,40 @@ io::VisualMapData ExportVisualMap(const VisualMap& map, const Trajectory& prior,
   return d;
 }
 
+std::unordered_map<int64_t, std::pair<size_t, size_t>> KeypointRowsByFrame(
+    const io::VisualMapData& data) {
+  std::unordered_map<int64_t, std::pair<size_t, size_t>> rows;
+  for (size_t p = 0; p < data.num_keypoints(); ++p) {
+    const int64_t f = data.keyframes.frames[static_cast<size_t>(data.keypoint_keyframe[p])];
+    auto [it, added] = rows.emplace(f, std::make_pair(p, p + 1));
+    JVL_CHECK(added || it->second.second == p,
+              "keypoints of frame " << f << " are not contiguous (row " << p << ")");
+    it->second.second = p + 1;
+  }
+  return rows;
+}
+
+vision::OrbFeatures KeyframeFeatures(const io::VisualMapData& data, size_t first, size_t last) {
+  JVL_CHECK(first <= last && last <= data.num_keypoints(),
+            "keypoint rows [" << first << ", " << last << ") outside the " << data.num_keypoints()
+                              << " of the visual map");
+  vision::OrbFeatures out;
+  out.keypoints.reserve(last - first);
+  out.descriptors.reserve(last - first);
+  for (size_t p = first; p < last; ++p) {
+    vision::OrbKeypoint k;
+    k.uv = Eigen::Vector2f(data.keypoint_uv[2 * p], data.keypoint_uv[2 * p + 1]);
+    k.octave = data.keypoint_octave[p];
+    k.angle = data.keypoint_angle[p];
+    out.keypoints.push_back(k);
+    vision::Descriptor d;
+    std::copy_n(data.keypoint_descriptor.begin() + static_cast<std::ptrdiff_t>(32 * p), 32,
+                d.begin());
+    out.descriptors.push_back(d);
+  }
+  return out;
+}
+
 VisualMapStats ComputeStats(const io::VisualMapData& d) {
   VisualMapStats s;
   s.keyframes = static_cast<int>(d.keyframes.size());

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "geometry/trajectory.h"
@@ -16,6 +18,16 @@ namespace jvl::mapping {
 // Flat artifact layout: good points only (renumbered), all keypoints of every keyframe,
 // observations ordered by (keyframe, keypoint), covisibility edges with weight >= min_weight.
 io::VisualMapData ExportVisualMap(const VisualMap& map, const Trajectory& prior, int min_weight);
+
+// Rows [first, last) of keypoints/* of each keyframe of the artifact, by frame id (the layout of
+// ExportVisualMap: keypoints grouped by keyframe).
+std::unordered_map<int64_t, std::pair<size_t, size_t>> KeypointRowsByFrame(
+    const io::VisualMapData& data);
+
+// The ORB features of keypoint rows [first, last): the keyframe's features as visual_assoc
+// extracted them (the inverse of ExportVisualMap for one keyframe; loop_detect reads them
+// instead of extracting ORB again).
+vision::OrbFeatures KeyframeFeatures(const io::VisualMapData& data, size_t first, size_t last);
 
 // Figures reported by visual_assoc and checked by the tests.
 struct VisualMapStats {
