@@ -81,7 +81,8 @@ struct RelativePoseConstraint {
 
 // A vehicle-motion constraint on three consecutive keyframes a, b, c (e_M; beyond the paper,
 // docs/global_opt.md "Motion term"): their body-frame velocity per frame should not change by
-// more than the vehicle's acceleration allows, sigma per axis of a's frame (metres per frame).
+// more than the vehicle's acceleration allows, sigma per camera axis of the rotations midway
+// between a and b, b and c (metres per frame; optim::MotionSmoothnessCost).
 struct MotionConstraint {
   int64_t a = 0, b = 0, c = 0;
   double frames_ab = 1.0, frames_bc = 1.0;

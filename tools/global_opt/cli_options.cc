@@ -5,6 +5,7 @@
 #include <string>
 
 #include "app/option_group.h"
+#include "core/check.h"
 
 namespace jvl::tools {
 
@@ -122,9 +123,10 @@ void ApplyGlobalOptFlags(const GlobalOptFlags& f, mapping::GlobalMappingOptions*
                                                         : Source::kFree;
   o->use_saved_imls = !f.no_saved_imls;
   o->fresh_traversal = !f.no_fresh_imls;
-  if (f.motion_sigma_mm.size() == 3)
-    o->motion_sigma_m =
-        1e-3 * Eigen::Vector3d(f.motion_sigma_mm[0], f.motion_sigma_mm[1], f.motion_sigma_mm[2]);
+  JVL_CHECK(f.motion_sigma_mm.size() == 3,
+            "--motion-sigma takes three values (x y z, mm) once, got " << f.motion_sigma_mm.size());
+  o->motion_sigma_m =
+      1e-3 * Eigen::Vector3d(f.motion_sigma_mm[0], f.motion_sigma_mm[1], f.motion_sigma_mm[2]);
 }
 
 }  // namespace jvl::tools

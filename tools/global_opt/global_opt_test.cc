@@ -202,6 +202,27 @@ TEST_F(GlobalOptTest, CommandLineWithAndWithoutDirections) {
   EXPECT_LT(few.stats["visual"]["selected_points"].get<int64_t>(),
             few.stats["visual"]["input_points"].get<int64_t>());
   EXPECT_GE(few.stats["visual"]["selected_observations"].get<int64_t>(), 5 * 40);
+  // The motion term: on by default over every three consecutive keyframes, sigma in mm on the
+  // command line, metres in the stats; --no-motion leaves it out.
+  EXPECT_TRUE(d.stats["motion"]["enabled"].get<bool>());
+  EXPECT_EQ(d.stats["motion"]["triples"].get<int64_t>(), 40 - 2);
+  EXPECT_EQ(d.stats["after"]["motion"]["count"].get<int64_t>(), 40 - 2);
+  EXPECT_DOUBLE_EQ(d.stats["motion"]["sigma_m"][2].get<double>(), 0.009);
+  ASSERT_EQ(std::system((defaults + " --motion-sigma 1 2 3 --motion-cauchy 0").c_str()), 0);
+  const auto given = io::ReadGlobalArtifact(Path("d.h5"));
+  EXPECT_DOUBLE_EQ(given.stats["motion"]["sigma_m"][0].get<double>(), 0.001);
+  EXPECT_DOUBLE_EQ(given.stats["motion"]["sigma_m"][1].get<double>(), 0.002);
+  EXPECT_DOUBLE_EQ(given.stats["motion"]["sigma_m"][2].get<double>(), 0.003);
+  EXPECT_DOUBLE_EQ(given.stats["motion"]["cauchy"].get<double>(), 0.0);
+  ASSERT_EQ(std::system((defaults + " --no-motion").c_str()), 0);
+  const auto none = io::ReadGlobalArtifact(Path("d.h5"));
+  EXPECT_FALSE(none.stats["motion"]["enabled"].get<bool>());
+  EXPECT_EQ(none.stats["motion"]["triples"].get<int64_t>(), 0);
+  EXPECT_EQ(none.stats["after"]["motion"]["count"].get<int64_t>(), 0);
+  // A repeated --motion-sigma is refused, not half used.
+  EXPECT_NE(
+      std::system((defaults + " --motion-sigma 1 2 3 --motion-sigma 4 5 6 2>/dev/null").c_str()),
+      0);
   // Bad input: one clear error line, non-zero exit.
   EXPECT_NE(std::system((exe + " --local " + Path("visual.h5") + " --visual " + Path("visual.h5") +
                          " --no-direction -o " + Path("x.h5") + " 2>/dev/null")

@@ -4,14 +4,17 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <iterator>
 #include <optional>
+#include <vector>
 
 #include "app/tool.h"
 #include "cli_options.h"
 #include "core/check.h"
 #include "core/memory.h"
+#include "core/statistics.h"
 #include "core/timer.h"
 #include "io/global_io.h"
 #include "io/loops_io.h"
@@ -184,6 +187,20 @@ int main(int argc, char** argv) {
         for (const io::VpRecord& v : io::ReadVpsArtifact(vps_path).vps)
           input.vp_rays.push_back({v.frame, v.direction});
       }
+    }
+    // e_M's sigma is per frame of a 10 Hz drive (the rate of the KITTI ground truth it comes
+    // from); at another rate the car's acceleration per frame scales with (interval / 0.1 s)^1.5.
+    if (o.use_motion && prior.has_timestamps() && prior.size() >= 2) {
+      std::vector<double> dt;
+      for (size_t i = 1; i < prior.size(); ++i)
+        if (prior.frames[i] == prior.frames[i - 1] + 1)
+          dt.push_back(prior.timestamps[i] - prior.timestamps[i - 1]);
+      const double interval = dt.empty() ? 0.1 : Median(dt);
+      if (interval > 0 && (interval < 0.08 || interval > 0.125))
+        spdlog::warn(
+            "the prior's frames are {:.3f} s apart; the motion term's --motion-sigma is per frame "
+            "at 10 Hz: for this rate scale it by {:.2f} (docs/global_opt.md \"Motion term\")",
+            interval, std::pow(interval / 0.1, 1.5));
     }
     ReleaseFreeHeapMemory();  // what reading the artifacts allocated and freed (core/memory.h)
     spdlog::debug("artifacts read and assembled in {:.1f} s", reading.ElapsedSeconds());

@@ -264,7 +264,11 @@ int main(int argc, char** argv) {
                             << map.scale_factor << ", the visual detector uses "
                             << visual_options.orb.num_levels << " x "
                             << visual_options.orb.scale_factor);
-      rows = mapping::KeypointRowsByFrame(map);
+      try {
+        rows = mapping::KeypointRowsByFrame(map);
+      } catch (const Error& e) {
+        JVL_THROW(visual_path << ": " << e.what());
+      }
       // Only the keypoints are needed.
       auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
       release(map.mappoint_position), release(map.mappoint_descriptor);

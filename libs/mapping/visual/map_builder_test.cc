@@ -157,6 +157,15 @@ TEST(VisualMapBuilder, SyntheticCorridorWithKnownPoses) {
     }
   }
   EXPECT_THROW(KeyframeFeatures(data, 0, data.num_keypoints() + 1), Error);
+  // Keypoints not grouped by keyframe (one of the first keyframe's moved behind the second's)
+  // and a keypoint of a keyframe that does not exist are refused.
+  io::VisualMapData ungrouped = data;
+  const size_t second_end = rows.at(map.keyframes[1].frame).second;
+  std::swap(ungrouped.keypoint_keyframe[0], ungrouped.keypoint_keyframe[second_end - 1]);
+  EXPECT_THROW(KeypointRowsByFrame(ungrouped), Error);
+  io::VisualMapData outside = data;
+  outside.keypoint_keyframe.back() = static_cast<int32_t>(data.keyframes.size());
+  EXPECT_THROW(KeypointRowsByFrame(outside), Error);
 }
 
 // Heading error (deg) of a pose against the truth.

@@ -142,7 +142,11 @@ std::unordered_map<int64_t, std::pair<size_t, size_t>> KeypointRowsByFrame(
     const io::VisualMapData& data) {
   std::unordered_map<int64_t, std::pair<size_t, size_t>> rows;
   for (size_t p = 0; p < data.num_keypoints(); ++p) {
-    const int64_t f = data.keyframes.frames[static_cast<size_t>(data.keypoint_keyframe[p])];
+    const int32_t k = data.keypoint_keyframe[p];
+    JVL_CHECK(
+        k >= 0 && static_cast<size_t>(k) < data.keyframes.size(),
+        "keypoint " << p << " refers to keyframe row " << k << " of " << data.keyframes.size());
+    const int64_t f = data.keyframes.frames[static_cast<size_t>(k)];
     auto [it, added] = rows.emplace(f, std::make_pair(p, p + 1));
     JVL_CHECK(added || it->second.second == p,
               "keypoints of frame " << f << " are not contiguous (row " << p << ")");
