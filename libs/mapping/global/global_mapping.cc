@@ -469,7 +469,8 @@ void SetOdometryTerm(int round, const GlobalMapInput& input, const GlobalMapping
   problem->relative_poses = term->constraints;
 }
 
-// e_M: every three consecutive keyframes (GlobalMappingOptions::use_motion).
+// e_M: every three consecutive keyframes (GlobalMappingOptions::use_motion; their frames
+// increase, GlobalMapInput::Check).
 std::vector<optim::MotionConstraint> MotionConstraints(const Trajectory& keyframes,
                                                        const GlobalMappingOptions& options) {
   std::vector<optim::MotionConstraint> out;
@@ -481,7 +482,6 @@ std::vector<optim::MotionConstraint> MotionConstraints(const Trajectory& keyfram
     m.c = static_cast<int64_t>(b + 1);
     m.frames_ab = static_cast<double>(keyframes.frames[b] - keyframes.frames[b - 1]);
     m.frames_bc = static_cast<double>(keyframes.frames[b + 1] - keyframes.frames[b]);
-    if (m.frames_ab <= 0 || m.frames_bc <= 0) continue;
     m.sigma_m = options.motion_sigma_m * std::sqrt(0.5 * (m.frames_ab + m.frames_bc));
     out.push_back(m);
   }
