@@ -1,5 +1,7 @@
 #include "io/odometry_io.h"
 
+#include <cmath>
+
 #include "core/check.h"
 #include "io/trajectory_io.h"
 
@@ -61,6 +63,23 @@ OdometryArtifact ReadOdometryArtifact(const std::string& path) {
   d.min_eigenvalue = reader.ReadArray<double>("diagnostics/min_eigenvalue");
   CheckDiagnostics(d, a.trajectory.size(), path);
   return a;
+}
+
+std::vector<double> ReadOdometryConditioning(const std::string& path) {
+  if (path.size() < 3 || path.compare(path.size() - 3, 3, ".h5") != 0) return {};
+  {
+    const H5Reader reader(path, "", 0);
+    if (reader.schema() != kOdometrySchema) return {};
+  }
+  const OdometryArtifact a = ReadOdometryArtifact(path);
+  std::vector<double> out(a.trajectory.size(), 0.0);
+  for (size_t k = 0; k < out.size(); ++k) {
+    const int32_t status = a.diagnostics.status[k];
+    const bool registered = status == 0 || status == 2;
+    const double v = a.diagnostics.min_eigenvalue[k];
+    out[k] = registered && std::isfinite(v) && v > 0 ? v : 0.0;
+  }
+  return out;
 }
 
 }  // namespace jvl::io

@@ -45,4 +45,10 @@ void WriteOdometryArtifact(const std::string& path, const OdometryArtifact& arti
                            const Provenance& provenance);
 OdometryArtifact ReadOdometryArtifact(const std::string& path);
 
+// How well each trajectory frame's registration was conditioned (diagnostics/min_eigenvalue; 0
+// where the frame was not registered: the first frame and motion-model frames), the per-frame
+// input of the global optimisation's odometry term. Empty if `path` is another kind of
+// trajectory file (a KITTI or TUM text file, another artifact).
+std::vector<double> ReadOdometryConditioning(const std::string& path);
+
 }  // namespace jvl::io

@@ -104,6 +104,41 @@ class PointToImlsCost {
   const double sqrt_information_;
 };
 
+// Visual-point-on-LiDAR-surface error e_S(k, j) (beyond the paper, docs/global_opt.md "Surface
+// term"): a map point X observed by keyframe k lies on the surface of k's own scan,
+//   X_k = R_wk^T (X - t_wk),   r = sqrt_info * (X_k - k_p_y) . n_k                     [1]
+// with k_p_y the projection of X_k onto the IMLS surface of k's scan and n_k its unit normal,
+// both in k's frame (found at the start of the round). Together with the point's reprojections
+// it fixes how far the cameras moved also where the scans alone cannot (a street without cross
+// structure), as a depth measurement would.
+class PointToSurfaceCost {
+ public:
+  PointToSurfaceCost(const Eigen::Vector3d& k_p_y, const Eigen::Vector3d& k_normal,
+                     double sqrt_information)
+      : k_p_y_(k_p_y), k_normal_(k_normal), sqrt_information_(sqrt_information) {}
+
+  template <typename T>
+  bool operator()(const T* world_from_k, const T* point, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q_wk(world_from_k);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_wk(world_from_k + 4);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> x_w(point);
+    const Eigen::Matrix<T, 3, 1> x_k = q_wk.conjugate() * (x_w - t_wk);
+    residual[0] = T(sqrt_information_) * (x_k - k_p_y_.cast<T>()).dot(k_normal_.cast<T>());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& k_p_y, const Eigen::Vector3d& k_normal,
+                                     double sqrt_information) {
+    return new ceres::AutoDiffCostFunction<PointToSurfaceCost, 1, 7, 3>(
+        new PointToSurfaceCost(k_p_y, k_normal, sqrt_information));
+  }
+
+ private:
+  const Eigen::Vector3d k_p_y_;
+  const Eigen::Vector3d k_normal_;
+  const double sqrt_information_;
+};
+
 // Direction projection error e_D(n) (Eq. 5-6): the direction prior d_w = [d_w, 0] is a point at
 // infinity, so its image is the vanishing point
 //   d_n = R_nw d_w = R_wn^T d_w,   r = sqrt_info * (v - pi(d_n))                   [2]

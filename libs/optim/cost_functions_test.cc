@@ -122,6 +122,31 @@ TEST(PointToImlsCost, InvariantToACommonRigidMotionOfBothPoses) {
   }
 }
 
+TEST(PointToSurfaceCost, ZeroOnSurfaceSignedAlongNormalBlindAlongItAndJacobianMatches) {
+  std::mt19937 rng(5);
+  const Rigid3d world_from_k = RandomPose(rng, 0.3, 5.0);
+  const Eigen::Vector3d k_p_y(2.0, -1.0, 10.0);
+  const Eigen::Vector3d k_normal = Eigen::Vector3d(0.3, 0.1, -1.0).normalized();
+  std::unique_ptr<ceres::CostFunction> cost(PointToSurfaceCost::Create(k_p_y, k_normal, 20.0));
+  PoseBlock pose = ToPoseBlock(world_from_k);
+  const auto at = [&](const Eigen::Vector3d& k_x) {
+    const Eigen::Vector3d w = world_from_k * k_x;
+    std::array<double, 3> point = {w.x(), w.y(), w.z()};
+    return Residuals(*cost, {pose.data(), point.data()})[0];
+  };
+  EXPECT_NEAR(at(k_p_y), 0.0, 1e-9);
+  // 0.05 m off the surface on the normal's side: r = +20 * 0.05; along the surface: 0.
+  EXPECT_NEAR(at(k_p_y + 0.05 * k_normal), 1.0, 1e-9);
+  EXPECT_NEAR(at(k_p_y - 0.05 * k_normal), -1.0, 1e-9);
+  const Eigen::Vector3d along = k_normal.cross(Eigen::Vector3d::UnitY()).normalized();
+  EXPECT_NEAR(at(k_p_y + 0.7 * along), 0.0, 1e-9);
+
+  const Eigen::Vector3d w = world_from_k * (k_p_y + 0.05 * k_normal + 0.3 * along);
+  std::array<double, 3> point = {w.x(), w.y(), w.z()};
+  std::string log;
+  EXPECT_LT(CheckGradient(*cost, {true, false}, {pose.data(), point.data()}, &log), 1e-6) << log;
+}
+
 TEST(DirectionProjectionCost, ZeroWhenDirectionProjectsOntoVp) {
   std::mt19937 rng(4);
   const PinholeCamera camera = KittiLikeCamera();

@@ -102,6 +102,16 @@ void CheckResiduals(const JointProblemInput& input) {
               "motion constraint (" << m.a << ", " << m.b << ", " << m.c
                                     << ") has a frame gap or a sigma <= 0");
   }
+  for (const PointSurfaceConstraint& c : input.point_surfaces) {
+    CheckKeyframe(input, c.keyframe, "surface constraint");
+    JVL_CHECK(c.map_point >= 0 && static_cast<size_t>(c.map_point) < input.map_points.size(),
+              "surface constraint of keyframe " << c.keyframe << " refers to map point "
+                                                << c.map_point << " of "
+                                                << input.map_points.size());
+    JVL_CHECK(Finite(c.k_p_y) && Finite(c.k_normal) && std::abs(c.k_normal.norm() - 1.0) < 1e-3,
+              "surface constraint of keyframe " << c.keyframe << " / map point " << c.map_point
+                                                << " has a non-finite point or a non-unit normal");
+  }
   for (size_t i = 0; i < input.free_directions.size(); ++i)
     JVL_CHECK(Finite(input.free_directions[i]) && input.free_directions[i].norm() > 1e-9,
               "free direction " << i << " is not finite or zero");
@@ -292,6 +302,9 @@ void JointProblemOptions::Check() const {
   JVL_CHECK(direction_min_z > 0 && direction_min_z < 1, "direction_min_z must be in (0, 1)");
   JVL_CHECK(std::isfinite(relative_cauchy), "relative_cauchy must be finite");
   JVL_CHECK(std::isfinite(motion_cauchy), "motion_cauchy must be finite");
+  JVL_CHECK(std::isfinite(surface_sigma_m) && surface_sigma_m > 0,
+            "surface_sigma_m must be positive");
+  JVL_CHECK(std::isfinite(surface_cauchy), "surface_cauchy must be finite");
   JVL_CHECK(std::isfinite(visual_gate_chi2), "visual_gate_chi2 must be finite");
   JVL_CHECK(std::isfinite(max_point_sigma_ratio), "max_point_sigma_ratio must be finite");
   JVL_CHECK(
@@ -391,6 +404,23 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
           MotionSmoothnessCost::Create(m.frames_ab, m.frames_bc, m.sigma_m.cwiseInverse()),
           motion_loss, jp.poses.at(m.a).data(), jp.poses.at(m.b).data(), jp.poses.at(m.c).data()));
     }
+  }
+
+  // e_S: whitened, weight 1, Cauchy kernel; only on points that the visual term holds (a point
+  // alone with its surface distance would be free along the surface).
+  if (!input.point_surfaces.empty()) {
+    ceres::LossFunction* surface_loss =
+        options.surface_cauchy > 0 ? new ceres::CauchyLoss(options.surface_cauchy) : nullptr;
+    bool used_loss = false;
+    for (const PointSurfaceConstraint& c : input.point_surfaces) {
+      double* point = jp.map_points[static_cast<size_t>(c.map_point)].data();
+      if (!jp.problem->HasParameterBlock(point)) continue;
+      jp.surface_blocks.push_back(jp.problem->AddResidualBlock(
+          PointToSurfaceCost::Create(c.k_p_y, c.k_normal, 1.0 / options.surface_sigma_m),
+          surface_loss, jp.poses.at(c.keyframe).data(), point));
+      used_loss = true;
+    }
+    if (!used_loss) delete surface_loss;
   }
 
   // Gauge: the fixed keyframes, or the first one (six degrees of freedom; LiDAR fixes scale).

@@ -89,6 +89,16 @@ struct MotionConstraint {
   Eigen::Vector3d sigma_m = Eigen::Vector3d::Constant(1e-2);
 };
 
+// A map point on the LiDAR surface of one of its observing keyframes (e_S; beyond the paper,
+// docs/global_opt.md "Surface term"): the projection of the point onto the IMLS surface of the
+// keyframe's own scan and its unit normal, in the keyframe's frame.
+struct PointSurfaceConstraint {
+  int64_t keyframe = 0;
+  int32_t map_point = 0;
+  Eigen::Vector3d k_p_y = Eigen::Vector3d::Zero();
+  Eigen::Vector3d k_normal = Eigen::Vector3d::UnitZ();
+};
+
 struct JointProblemInput {
   PinholeCamera camera;
   // The observing camera's offset from the poses' frame (camera 0): x_camera = x_cam0 + offset.
@@ -115,6 +125,8 @@ struct JointProblemInput {
   std::vector<Eigen::Vector3d> free_directions;        // initial values of the free d_w blocks
   std::vector<RelativePoseConstraint> relative_poses;  // e_O (weight 1 on whitened residuals)
   std::vector<MotionConstraint> motion;                // e_M (weight 1 on whitened residuals)
+  // e_S (weight 1 on whitened residuals); only points that are in the visual term are used.
+  std::vector<PointSurfaceConstraint> point_surfaces;
 };
 
 struct JointProblemOptions {
@@ -149,6 +161,11 @@ struct JointProblemOptions {
   // Cauchy kernel of e_M on its whitened norm (<= 0: none): a real acceleration (braking, a
   // turn's start) many sigmas out keeps a bounded cost.
   double motion_cauchy = 3.0;
+  // e_S: sigma of a map point's distance to the LiDAR surface (m) and Cauchy kernel on the
+  // whitened residual (<= 0: none). Corner keypoints lie on depth edges, where the surface
+  // found may be the wrong one: the kernel bounds them.
+  double surface_sigma_m = 0.05;
+  double surface_cauchy = 1.0;
   // Outlier gate on e_V at the initial estimate (whitened squared reprojection error; <= 0: off).
   // Observations above it are left out of the problem, and with free map points so is every
   // point left with fewer than 2 observations (its depth would be unconstrained). ORB-SLAM's
@@ -194,7 +211,7 @@ struct JointProblem {
   std::vector<std::array<double, 3>> free_directions;
   std::unique_ptr<ceres::Problem> problem;
   std::vector<ceres::ResidualBlockId> visual_blocks, imls_blocks, direction_blocks, relative_blocks,
-      motion_blocks;
+      motion_blocks, surface_blocks;
   std::vector<int64_t> imls_block_counts;  // correspondences in each of imls_blocks
   std::set<int64_t> fixed;                 // effective constant poses (gauge)
   JointWeights weights;
@@ -246,7 +263,7 @@ struct ResidualStats {
 };
 
 struct JointCostBreakdown {
-  ResidualStats visual, imls, direction, relative, motion;
+  ResidualStats visual, imls, direction, relative, motion, surface;
   double total = 0.0;
 };
 

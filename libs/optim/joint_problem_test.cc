@@ -142,8 +142,17 @@ TEST(JointProblem, RejectsInconsistentInput) {
   bad = toy.input;
   bad.fixed = {12345};
   EXPECT_THROW(BuildJointProblem(bad, {}), Error);
+  bad = toy.input;
+  bad.point_surfaces.push_back({0, 0, Eigen::Vector3d(1, 0, 5), Eigen::Vector3d(2, 0, 0)});
+  EXPECT_THROW(BuildJointProblem(bad, {}), Error);  // not a unit normal
+  bad = toy.input;
+  bad.point_surfaces.push_back({0, -1, Eigen::Vector3d(1, 0, 5), Eigen::Vector3d(1, 0, 0)});
+  EXPECT_THROW(BuildJointProblem(bad, {}), Error);
   JointProblemOptions options;
   options.alpha = 0;
+  EXPECT_THROW(BuildJointProblem(toy.input, options), Error);
+  options = {};
+  options.surface_sigma_m = 0;
   EXPECT_THROW(BuildJointProblem(toy.input, options), Error);
 }
 
@@ -370,6 +379,96 @@ TEST(JointProblem, MotionTermTakesFrameNoiseTheOtherTermsCannotSee) {
   // A bad constraint is refused with a message.
   in.motion.push_back({0, 0, 1, 1.0, 1.0, Eigen::Vector3d::Constant(0.01)});
   EXPECT_THROW(OptimizeJoint(in, {}, {}), Error);
+}
+
+// The surface term in a corridor: walls and ground only, so the scans cannot tell how far the
+// car moved, and the map points, free, can be placed at any scale with the cameras (a scene
+// scaled about the first keyframe reprojects the same and keeps every wall and ground
+// correspondence). The keyframes start 3 % too far apart, as an odometry that slid along the
+// street. With the map points tied to the surface of their keyframes' own scans, the spacing
+// comes out right; without, it stays where it started.
+TEST(JointProblem, SurfaceTermFixesTheSpacingInACorridorTheScansCannotSee) {
+  constexpr int kKeyframes = 16;
+  constexpr double kSpacing = 2.0;
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> pixel_noise(0.0, 0.5), range_noise(0.0, 0.01);
+  JointProblemInput in;
+  in.camera = testing::KittiLikeCamera();
+  std::map<int64_t, Rigid3d> truth;
+  for (int k = 0; k < kKeyframes; ++k) {
+    truth[k] = Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, kSpacing * k));
+    in.poses[k] =
+        Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1.03 * kSpacing * k));
+  }
+  in.fixed = {0};
+  std::vector<Eigen::Vector3d> true_points;
+  for (int k = 0; k < kKeyframes; ++k) {
+    for (int i = 0; i < 30; ++i) {  // wall points 8 m left and right, 6-30 m ahead of k
+      const double side = i % 2 == 0 ? -1.0 : 1.0;
+      const Eigen::Vector3d p_w(side * 8.0, -2.0 + 3.5 * u(rng),
+                                kSpacing * k + 6.0 + 24.0 * u(rng));
+      const int32_t id = static_cast<int32_t>(true_points.size());
+      true_points.push_back(p_w);
+      // Triangulated at the slid poses: the same rays, 1.03x the distances from keyframe 0.
+      in.map_points.push_back(1.03 * p_w);
+      for (int j = k; j < std::min(k + 3, kKeyframes); ++j) {
+        const Eigen::Vector3d p_j = truth[j].Inverse() * p_w;
+        if (p_j.z() < 1.0 || !in.camera.InImage(in.camera.Project(p_j))) continue;
+        const Eigen::Vector2d noise(pixel_noise(rng), pixel_noise(rng));
+        in.observations.push_back({j, id, in.camera.Project(p_j) + noise, 0});
+        PointSurfaceConstraint c;
+        c.keyframe = j;
+        c.map_point = id;
+        c.k_normal = Eigen::Vector3d(-side, 0, 0);
+        c.k_p_y = p_j + range_noise(rng) * c.k_normal;
+        in.point_surfaces.push_back(c);
+      }
+    }
+    if (k == 0) continue;
+    for (int i = 0; i < 30; ++i) {  // walls and ground between k and k - 1: no forward term
+      ImlsCorrespondence l;
+      l.n = k;
+      l.c = k - 1;
+      const double z = 3.0 + 20.0 * u(rng);
+      if (i % 3 == 0) {
+        l.c_p_y = Eigen::Vector3d(-6.0 + 12.0 * u(rng), 1.7, z);
+        l.c_normal = -Eigen::Vector3d::UnitY();
+      } else {
+        const double side = i % 3 == 1 ? -1.0 : 1.0;
+        l.c_p_y = Eigen::Vector3d(side * 8.0, -2.0 + 3.5 * u(rng), z);
+        l.c_normal = Eigen::Vector3d(-side, 0, 0);
+      }
+      const Eigen::Vector3d sampled = l.c_p_y + range_noise(rng) * l.c_normal;
+      l.p_x = truth[k].Inverse() * (truth[k - 1] * sampled);
+      in.imls.push_back(l);
+    }
+  }
+  const auto spacing_error = [&](const JointSolveResult& r) {
+    double worst = 0.0;
+    for (int k = 1; k < kKeyframes; ++k) {
+      const double step = r.poses.at(k).translation().z() - r.poses.at(k - 1).translation().z();
+      worst = std::max(worst, std::abs(step - kSpacing));
+    }
+    return worst;
+  };
+  const JointSolveResult with = OptimizeJoint(in, {}, {});
+  EXPECT_GT(with.after.surface.count, 0);
+  JointProblemInput without_input = in;
+  without_input.point_surfaces.clear();
+  const JointSolveResult without = OptimizeJoint(without_input, {}, {});
+  EXPECT_EQ(without.after.surface.count, 0);
+  ASSERT_TRUE(with.usable && without.usable);
+  EXPECT_GT(spacing_error(without), 0.04) << "the corridor should leave the spacing undetermined";
+  EXPECT_LT(spacing_error(with), 0.01) << spacing_error(with) << " m";
+  // A constraint on a point the visual term does not hold is left out (it would be free along
+  // the surface).
+  JointProblemInput lone = in;
+  lone.map_points.push_back(Eigen::Vector3d(8, 0, 10));
+  lone.point_surfaces.push_back({1, static_cast<int32_t>(lone.map_points.size() - 1),
+                                 Eigen::Vector3d(8, 0, 8), Eigen::Vector3d(-1, 0, 0)});
+  JointProblem built = BuildJointProblem(lone, {});
+  EXPECT_EQ(built.surface_blocks.size(), in.point_surfaces.size());
 }
 
 }  // namespace

@@ -121,6 +121,7 @@ JointCostBreakdown CountResiduals(const JointProblem& jp) {
   b.direction.count = static_cast<int64_t>(jp.direction_blocks.size());
   b.relative.count = static_cast<int64_t>(jp.relative_blocks.size());
   b.motion.count = static_cast<int64_t>(jp.motion_blocks.size());
+  b.surface.count = static_cast<int64_t>(jp.surface_blocks.size());
   return b;
 }
 
@@ -133,7 +134,9 @@ JointCostBreakdown EvaluateJointCost(JointProblem& jp) {
   b.direction = Evaluate(*jp.problem, jp.direction_blocks, b.direction.count);
   b.relative = Evaluate(*jp.problem, jp.relative_blocks, b.relative.count);
   b.motion = Evaluate(*jp.problem, jp.motion_blocks, b.motion.count);
-  b.total = b.visual.cost + b.imls.cost + b.direction.cost + b.relative.cost + b.motion.cost;
+  b.surface = Evaluate(*jp.problem, jp.surface_blocks, b.surface.count);
+  b.total = b.visual.cost + b.imls.cost + b.direction.cost + b.relative.cost + b.motion.cost +
+            b.surface.cost;
   return b;
 }
 

@@ -70,8 +70,23 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
   method.Add("--odometry-gate", o->odometry_gate,
              "Leave out odometry pairs whose whitened e_O exceeds this at the first round's "
              "solution (the odometry's steps; <= 0: keep all)");
+  method.Flag("!--no-odometry-conditioning", o->odometry_conditioning,
+              "Give every odometry frame e_O's sigma of the drive, also where the odometry "
+              "artifact says its registration was weakly conditioned (ablation)");
+  method.Add("--odometry-max-inflation", o->odometry_max_inflation,
+             "Largest factor on a weakly conditioned (or unregistered) frame's e_O sigma, "
+             "sqrt(median / own smallest eigenvalue of the registration), >= 1");
   method.Add("--odometry-cauchy", o->joint.relative_cauchy,
              "Cauchy kernel scale of e_O on its whitened norm (<= 0: none)");
+  method.Flag("!--no-surface", o->use_surface,
+              "Leave out the surface term e_S (visual map points on their keyframe's LiDAR "
+              "surface; beyond the paper; ablation)");
+  method.Add("--surface-sigma", o->joint.surface_sigma_m,
+             "e_S's sigma: a map point's distance to the LiDAR surface, m");
+  method.Add("--surface-max-distance", o->surface_max_distance_m,
+             "e_S: a map point farther than this (m) from its keyframe's surface is left out");
+  method.Add("--surface-cauchy", o->joint.surface_cauchy,
+             "Cauchy kernel scale of e_S on its whitened residual (<= 0: none)");
   method.Flag("!--no-motion", o->use_motion,
               "Leave out the motion term e_M (the car's acceleration between three consecutive "
               "keyframes; beyond the paper; ablation)");

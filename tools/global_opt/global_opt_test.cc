@@ -143,10 +143,12 @@ TEST_F(GlobalOptTest, CommandLineWithAndWithoutDirections) {
   if (!io::FileExists(exe)) GTEST_SKIP() << exe << " not built";
   // The toy's map points are placed from the truth while its poses drift: not the consistent
   // local_map output the default visual gate and weak-point holding assume (they would drop or
-  // hold most of the visual term here), so both are off; the defaults are checked below.
+  // hold most of the visual term here), so both are off; the defaults are checked below. Its
+  // scans and map points agree with the drifted prior by construction, and e_S, which ties the
+  // points to the scans, would add to that agreement: off too.
   const std::string base = exe + " --local " + Path("local.h5") + " --visual " + Path("visual.h5") +
                            " --threads 2 --quiet --log-level warn --visual-gate 0 "
-                           "--max-point-sigma 0";
+                           "--max-point-sigma 0 --no-surface";
   const Timer t;
   // The toy's VPs have 0.5 px noise; sigma is given (the estimate at the warm-started poses would
   // count the drift as noise, see global_mapping_test.cc).
@@ -219,6 +221,19 @@ TEST_F(GlobalOptTest, CommandLineWithAndWithoutDirections) {
   EXPECT_FALSE(none.stats["motion"]["enabled"].get<bool>());
   EXPECT_EQ(none.stats["motion"]["triples"].get<int64_t>(), 0);
   EXPECT_EQ(none.stats["after"]["motion"]["count"].get<int64_t>(), 0);
+  // The surface term: on by default (map points against their keyframe's own scan), sigma and
+  // gate in the stats; --no-surface leaves it out.
+  EXPECT_TRUE(d.stats["surface"]["enabled"].get<bool>());
+  EXPECT_GT(d.stats["surface"]["constraints"].get<int64_t>(), 0);
+  EXPECT_GT(d.stats["after"]["surface"]["count"].get<int64_t>(), 0);
+  EXPECT_DOUBLE_EQ(d.stats["surface"]["sigma_m"].get<double>(), 0.05);
+  EXPECT_DOUBLE_EQ(d.stats["surface"]["max_distance_m"].get<double>(), 0.15);
+  EXPECT_DOUBLE_EQ(d.stats["surface"]["cauchy"].get<double>(), 1.0);
+  ASSERT_EQ(std::system((defaults + " --no-surface").c_str()), 0);
+  const auto no_surface = io::ReadGlobalArtifact(Path("d.h5"));
+  EXPECT_FALSE(no_surface.stats["surface"]["enabled"].get<bool>());
+  EXPECT_EQ(no_surface.stats["surface"]["constraints"].get<int64_t>(), 0);
+  EXPECT_EQ(no_surface.stats["after"]["surface"]["count"].get<int64_t>(), 0);
   // A repeated --motion-sigma is refused, not half used.
   EXPECT_NE(
       std::system((defaults + " --motion-sigma 1 2 3 --motion-sigma 4 5 6 2>/dev/null").c_str()),

@@ -18,6 +18,7 @@
 #include "core/timer.h"
 #include "io/global_io.h"
 #include "io/loops_io.h"
+#include "io/odometry_io.h"
 #include "io/ply_io.h"
 #include "io/trajectory_io.h"
 #include "io/vps_io.h"
@@ -53,7 +54,8 @@ int main(int argc, char** argv) {
       "Odometry of the odometry term e_O: its motion between consecutive keyframes, robustly "
       "weighted (.h5 artifact, KITTI, TUM; default: the prior). In a re-association pass, "
       "pass the chain's first prior (lidar_odom) here: its motion is locally smoother than a "
-      "global result's"));
+      "global result's. A lidar_odom artifact also gives each frame's registration "
+      "conditioning, which widens e_O where the scan held the motion weakly"));
   tool.InputFile(cli.add_option(
       "--loops", loops_path,
       "loops artifact (loop_detect): its accepted loops correct the keyframes before the "
@@ -118,14 +120,25 @@ int main(int argc, char** argv) {
       }
       JVL_CHECK(!prior.empty(), "no prior trajectory: pass --prior");
       Trajectory odometry = prior;
+      std::vector<double> conditioning;
       if (!odometry_path.empty()) {
         odometry = io::ReadTrajectory(odometry_path);
+        conditioning = io::ReadOdometryConditioning(odometry_path);
         tool.AddInput(odometry_path);
+      } else if (!prior_path.empty()) {
+        conditioning = io::ReadOdometryConditioning(prior_path);
       }
+      if (o.use_odometry && o.odometry_conditioning && conditioning.empty())
+        spdlog::info(
+            "odometry term: the odometry is no lidar_odom artifact; every frame gets "
+            "the drive's sigma (no registration conditioning)");
       o.joint.octave_scale_factor = visual.scale_factor;
       input = mapping::AssembleGlobalInput(visual, std::move(local),
                                            directions_path.empty() ? nullptr : &directions);
-      if (o.use_odometry) input.odometry = std::move(odometry);
+      if (o.use_odometry) {
+        input.odometry = std::move(odometry);
+        input.odometry_conditioning = std::move(conditioning);
+      }
       if (!loops_path.empty()) {
         tool.AddInput(loops_path);
         // A loop end that is not a keyframe moves to the nearest keyframe within

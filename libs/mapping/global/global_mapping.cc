@@ -47,6 +47,12 @@ void GlobalMapInput::Check() const {
     JVL_CHECK(p.n >= 0 && p.n < k && p.c >= 0 && p.c < k,
               "IMLS pair (" << p.n << ", " << p.c << ") out of range");
   if (!odometry.empty()) odometry.Check("global input odometry");
+  JVL_CHECK(odometry_conditioning.empty() || odometry_conditioning.size() == odometry.size(),
+            "odometry conditioning has " << odometry_conditioning.size()
+                                         << " entries for an odometry of " << odometry.size()
+                                         << " frames");
+  for (const double c : odometry_conditioning)
+    JVL_CHECK(std::isfinite(c), "odometry conditioning must be finite");
   for (const auto& l : loops)
     JVL_CHECK(l.match >= 0 && l.match < l.query && l.query < k,
               "loop (" << l.match << ", " << l.query << ") out of range or not match < query");
@@ -151,6 +157,10 @@ void GlobalMappingOptions::Check() const {
                 min_direction_sigma_px > 0,
             "direction_sigma_px must be finite and min_direction_sigma_px > 0");
   JVL_CHECK(std::isfinite(odometry_gate), "odometry_gate must be finite");
+  JVL_CHECK(std::isfinite(odometry_max_inflation) && odometry_max_inflation >= 1,
+            "odometry_max_inflation must be >= 1, got " << odometry_max_inflation);
+  JVL_CHECK(std::isfinite(surface_max_distance_m) && surface_max_distance_m > 0,
+            "surface_max_distance_m must be > 0, got " << surface_max_distance_m);
   JVL_CHECK(motion_sigma_m.allFinite() && motion_sigma_m.minCoeff() > 0,
             "motion_sigma_m must be finite and > 0");
   JVL_CHECK(
@@ -379,36 +389,60 @@ struct OdometryTerm {
 };
 
 // The residual of E = Z^-1 (T_i^-1 T_j) per axis, [2 vec(q_E); t_E] (optim::RelativePoseCost with
-// unit whitening), per frame of the interval (divided by sqrt(frames)).
+// unit whitening), divided by `scale` (the pair's sigma in units of one well-conditioned frame's).
 Eigen::Matrix<double, 6, 1> RelativeError(const optim::RelativePoseConstraint& c,
-                                          const Trajectory& keyframes, int64_t frames) {
+                                          const Trajectory& keyframes, double scale) {
   const optim::RelativePoseCost cost(c.i_from_j.rotation(), c.i_from_j.translation(),
                                      Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones());
   const optim::PoseBlock i = optim::ToPoseBlock(keyframes.world_from_cam[c.i]);
   const optim::PoseBlock j = optim::ToPoseBlock(keyframes.world_from_cam[c.j]);
   Eigen::Matrix<double, 6, 1> r;
   cost(i.data(), j.data(), r.data());
-  return r / std::sqrt(static_cast<double>(std::max<int64_t>(frames, 1)));
+  return r / scale;
 }
 
 // Squared norm of the whitened residual of `c` at `keyframes`.
 double WhitenedSquaredNorm(const optim::RelativePoseConstraint& c, const Trajectory& keyframes) {
-  const Eigen::Matrix<double, 6, 1> r = RelativeError(c, keyframes, 1);
+  const Eigen::Matrix<double, 6, 1> r = RelativeError(c, keyframes, 1.0);
   return r.head<3>().cwiseQuotient(c.sigma_rad).squaredNorm() +
          r.tail<3>().cwiseQuotient(c.sigma_m).squaredNorm();
 }
 
+// Per odometry row, the variance factor of its frame's motion (GlobalMappingOptions::
+// odometry_conditioning): lambda_ref / lambda clamped to [1, max_inflation^2]; all 1 without
+// conditioning values.
+std::vector<double> OdometryVarianceFactors(const std::vector<double>& conditioning,
+                                            const GlobalMappingOptions& options) {
+  std::vector<double> factor(conditioning.size(), 1.0);
+  if (!options.odometry_conditioning) return factor;
+  std::vector<double> registered;
+  for (const double c : conditioning)
+    if (c > 0) registered.push_back(c);
+  if (registered.empty()) return factor;
+  const double ref = Median(registered);
+  const double max_factor = options.odometry_max_inflation * options.odometry_max_inflation;
+  for (size_t k = 0; k < conditioning.size(); ++k)
+    factor[k] =
+        conditioning[k] > 0 ? std::clamp(ref / conditioning[k], 1.0, max_factor) : max_factor;
+  return factor;
+}
+
 // The odometry's motion between consecutive keyframes whose frames it holds, with a sigma per
 // axis measured against `keyframes` (the first round's solution): 1.4826 x the median absolute
-// per-frame residual (MAD about zero), at least the minimum; the pairs above the gate are left
-// out.
+// per-frame residual (MAD about zero; each residual divided by its pair's scale), at least the
+// minimum; the pairs above the gate are left out. A pair's scale is the square root of its
+// frame count times the mean variance factor of the odometry rows after the first keyframe up to
+// the second (OdometryVarianceFactors).
 void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
-                   const GlobalMappingOptions& options, OdometryTerm* term,
-                   GlobalMappingResult* result) {
+                   const std::vector<double>& conditioning, const GlobalMappingOptions& options,
+                   OdometryTerm* term, GlobalMappingResult* result) {
   term->entered = true;
   if (odometry.empty()) return;
+  const std::vector<double> factor = OdometryVarianceFactors(conditioning, options);
+  result->odometry_conditioned = options.odometry_conditioning && !conditioning.empty();
   std::vector<optim::RelativePoseConstraint> pairs;
-  std::vector<int64_t> frames;
+  std::vector<double> scale;
+  std::vector<double> inflation;
   for (size_t i = 0; i + 1 < keyframes.size(); ++i) {
     const auto a = odometry.IndexOf(keyframes.frames[i]);
     const auto b = odometry.IndexOf(keyframes.frames[i + 1]);
@@ -418,7 +452,16 @@ void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
     c.j = static_cast<int64_t>(i + 1);
     c.i_from_j = odometry.world_from_cam[*a].Inverse() * odometry.world_from_cam[*b];
     pairs.push_back(c);
-    frames.push_back(keyframes.frames[i + 1] - keyframes.frames[i]);
+    double mean_factor = 1.0;
+    if (!factor.empty() && *b > *a) {
+      double sum = 0;
+      for (size_t r = *a + 1; r <= *b; ++r) sum += factor[r];
+      mean_factor = sum / static_cast<double>(*b - *a);
+    }
+    const auto frames =
+        static_cast<double>(std::max<int64_t>(keyframes.frames[i + 1] - keyframes.frames[i], 1));
+    scale.push_back(std::sqrt(frames * mean_factor));
+    inflation.push_back(std::sqrt(mean_factor));
   }
   result->odometry_pairs = static_cast<int64_t>(pairs.size());
   if (pairs.empty()) {
@@ -427,7 +470,7 @@ void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
   }
   std::vector<std::vector<double>> abs(6);
   for (size_t k = 0; k < pairs.size(); ++k) {
-    const Eigen::Matrix<double, 6, 1> r = RelativeError(pairs[k], keyframes, frames[k]);
+    const Eigen::Matrix<double, 6, 1> r = RelativeError(pairs[k], keyframes, scale[k]);
     for (int a = 0; a < 6; ++a) abs[a].push_back(std::abs(r(a)));
   }
   Eigen::Vector3d sigma_rad, sigma_m;
@@ -439,9 +482,9 @@ void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
   result->odometry_sigma_m = sigma_m;
   for (size_t k = 0; k < pairs.size(); ++k) {
     optim::RelativePoseConstraint c = pairs[k];
-    const double s = std::sqrt(static_cast<double>(frames[k]));
-    c.sigma_rad = sigma_rad * s;
-    c.sigma_m = sigma_m * s;
+    c.sigma_rad = sigma_rad * scale[k];
+    c.sigma_m = sigma_m * scale[k];
+    if (inflation[k] > 2.0) ++result->odometry_inflated;
     if (options.odometry_gate > 0 &&
         WhitenedSquaredNorm(c, keyframes) > options.odometry_gate * options.odometry_gate) {
       ++result->odometry_gated;
@@ -450,11 +493,11 @@ void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
     term->constraints.push_back(c);
   }
   spdlog::info(
-      "odometry term: {} keyframe pairs ({} left out above the gate), sigma per frame "
-      "({:.4f}, {:.4f}, {:.4f}) m, ({:.4f}, {:.4f}, {:.4f}) deg (camera x, y, z; measured against "
-      "the first round)",
-      term->constraints.size(), result->odometry_gated, sigma_m.x(), sigma_m.y(), sigma_m.z(),
-      result->odometry_sigma_deg.x(), result->odometry_sigma_deg.y(),
+      "odometry term: {} keyframe pairs ({} left out above the gate, {} with a sigma raised "
+      "over 2x by a weakly conditioned registration), sigma per frame ({:.4f}, {:.4f}, {:.4f}) m, "
+      "({:.4f}, {:.4f}, {:.4f}) deg (camera x, y, z; measured against the first round)",
+      term->constraints.size(), result->odometry_gated, result->odometry_inflated, sigma_m.x(),
+      sigma_m.y(), sigma_m.z(), result->odometry_sigma_deg.x(), result->odometry_sigma_deg.y(),
       result->odometry_sigma_deg.z());
 }
 
@@ -465,7 +508,9 @@ void SetOdometryTerm(int round, const GlobalMapInput& input, const GlobalMapping
                      GlobalMappingResult* result) {
   problem->relative_poses.clear();
   if (!options.use_odometry || input.odometry.empty() || round < 1) return;
-  if (!term->entered) EnterOdometry(result->keyframes, input.odometry, options, term, result);
+  if (!term->entered)
+    EnterOdometry(result->keyframes, input.odometry, input.odometry_conditioning, options, term,
+                  result);
   problem->relative_poses = term->constraints;
 }
 
@@ -742,6 +787,47 @@ void SetDirectionTerm(int round, const FixedTerms& terms, const PinholeCamera& c
   problem->free_directions = term->free_directions;
 }
 
+// e_S of this round (GlobalMappingOptions::use_surface): every observation's map point, at
+// the current point and pose, projected onto the IMLS surface of its keyframe's own scan (the
+// traversal's association options: kernel, radius, largest distance). One model per keyframe,
+// keyframes in parallel, joined in keyframe order (the same for any thread count).
+std::vector<optim::PointSurfaceConstraint> SurfaceConstraints(
+    const Trajectory& keyframes, const std::vector<lidar::StoredScan>& scans,
+    const std::vector<optim::VisualObservation>& observations,
+    const std::vector<Eigen::Vector3d>& map_points, const lidar::AssociationOptions& association,
+    int threads) {
+  const size_t k = keyframes.size();
+  JVL_CHECK(scans.size() == k,
+            "surface term: " << scans.size() << " scans for " << k << " keyframes");
+  std::vector<std::vector<size_t>> by_keyframe(k);
+  for (size_t o = 0; o < observations.size(); ++o)
+    by_keyframe[static_cast<size_t>(observations[o].keyframe)].push_back(o);
+  std::vector<std::vector<optim::PointSurfaceConstraint>> parts(k);
+  ParallelFor(static_cast<int64_t>(k), ResolveThreadCount(threads), [&](int64_t row) {
+    const size_t n = static_cast<size_t>(row);
+    if (by_keyframe[n].empty() || scans[n].size() == 0) return;
+    lidar::ImlsModel model(association.search_radius);
+    lidar::AddScanToModel(scans[n].points, scans[n].normals, Rigid3d(), row, &model);
+    const Rigid3d cam_from_world = keyframes.world_from_cam[n].Inverse();
+    for (const size_t o : by_keyframe[n]) {
+      const int32_t point = observations[o].map_point;
+      lidar::ImlsProjection proj;
+      if (!lidar::ProjectPoint(model, cam_from_world * map_points[static_cast<size_t>(point)],
+                               association, &proj))
+        continue;
+      optim::PointSurfaceConstraint c;
+      c.keyframe = row;
+      c.map_point = point;
+      c.k_p_y = proj.projection;
+      c.k_normal = proj.normal.normalized();
+      parts[n].push_back(c);
+    }
+  });
+  std::vector<optim::PointSurfaceConstraint> out;
+  for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
+  return out;
+}
+
 // e_L (Eq. 3-4) of this round: the saved set L and, with a fresh traversal, Eq. (3) against the
 // current poses (the paper's single traversal in round 0). The scans are released after the
 // last traversal (on a long sequence they are a large part of the memory).
@@ -884,6 +970,19 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
     SetDirectionTerm(round, terms, input.camera, options, &direction, &joint, &problem, &result);
+    problem.point_surfaces.clear();
+    if (options.use_surface && !input.scans.empty()) {
+      lidar::AssociationOptions association = options.traversal.association;
+      association.max_distance = options.surface_max_distance_m;
+      problem.point_surfaces =
+          SurfaceConstraints(result.keyframes, input.scans, input.observations, problem.map_points,
+                             association, options.solve.threads);
+      result.surface_constraints = static_cast<int64_t>(problem.point_surfaces.size());
+      spdlog::info("surface term: {} map point observations on their keyframe's scan",
+                   problem.point_surfaces.size());
+    } else if (options.use_surface && round == 0) {
+      spdlog::info("surface term left out: the local map holds no scans");
+    }
     SetImlsTerm(round, terms, options, &input, &problem, &result);
     SetOdometryTerm(round, input, options, &odometry, &problem, &result);
     const auto direction_before = DirectionCostBefore(round, terms, problem, joint, options);
@@ -947,9 +1046,13 @@ nlohmann::json FreeJson(const GlobalMappingResult& r) {
 }
 
 nlohmann::json BreakdownOf(const optim::JointCostBreakdown& b) {
-  return {{"visual", StatsOf(b.visual)},       {"imls", StatsOf(b.imls)},
-          {"direction", StatsOf(b.direction)}, {"odometry", StatsOf(b.relative)},
-          {"motion", StatsOf(b.motion)},       {"total", b.total}};
+  return {{"visual", StatsOf(b.visual)},
+          {"imls", StatsOf(b.imls)},
+          {"direction", StatsOf(b.direction)},
+          {"odometry", StatsOf(b.relative)},
+          {"motion", StatsOf(b.motion)},
+          {"surface", StatsOf(b.surface)},
+          {"total", b.total}};
 }
 
 }  // namespace
@@ -1013,7 +1116,17 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
         {"outliers", r.odometry_outliers},
         {"sigma_m", VectorJson(r.odometry_sigma_m)},
         {"sigma_deg", VectorJson(r.odometry_sigma_deg)},
+        {"conditioning",
+         {{"used", r.odometry_conditioned},
+          {"max_inflation", o.odometry_max_inflation},
+          {"inflated", r.odometry_inflated}}},
         {"cauchy", o.joint.relative_cauchy}}},
+      {"surface",
+       {{"enabled", o.use_surface},
+        {"constraints", r.surface_constraints},
+        {"sigma_m", o.joint.surface_sigma_m},
+        {"max_distance_m", o.surface_max_distance_m},
+        {"cauchy", o.joint.surface_cauchy}}},
       {"motion",
        {{"enabled", o.use_motion},
         {"triples", r.motion_triples},

@@ -65,6 +65,12 @@ struct GlobalMapInput {
   // The odometry of the odometry term e_O (GlobalMappingOptions::use_odometry): any trajectory
   // holding the keyframes' frames (e.g. the lidar_odom prior). Empty: no e_O.
   Trajectory odometry;
+  // Per row of `odometry` (optional; empty: every frame alike): how well the frame's registration
+  // was conditioned, lidar_odom's smallest normalised eigenvalue of the registration's normal
+  // matrix (its diagnostics/min_eigenvalue; <= 0: the frame was not registered). Where it is
+  // small the scan held the motion weakly along some direction (a street without cross
+  // structure) and e_O's sigma there grows (GlobalMappingOptions::odometry_conditioning).
+  std::vector<double> odometry_conditioning;
   // Loops (GlobalMappingOptions::use_loops): the keyframes are corrected before the first round
   // (ApplyLoopCorrections), and every round adds point-to-IMLS correspondences of each loop's
   // query scan against the scans around its match; a visual loop's points join the visual term
@@ -177,6 +183,16 @@ struct GlobalMappingOptions {
   double odometry_gate = 4.1;
   double min_odometry_sigma_m = 0.001;
   double min_odometry_sigma_deg = 0.01;
+  // With GlobalMapInput::odometry_conditioning: a frame's e_O sigma (rotation and translation)
+  // is times sqrt(lambda_ref / lambda), lambda its smallest normalised eigenvalue and lambda_ref
+  // the median over the odometry's registered frames, clamped to [1, odometry_max_inflation]
+  // (a frame without a registration: the maximum). A least-squares estimate's variance along its
+  // weakest direction is 1 / lambda_min times the residuals' variance; where lidar_odom slid
+  // along a street, e_O no longer holds the slide in place. A pair of keyframes n frames apart
+  // sums its frames' variances (n frames alike: sigma x sqrt(n), as without). The sigma of the
+  // drive (above) is measured on residuals divided by the same factor.
+  bool odometry_conditioning = true;
+  double odometry_max_inflation = 10.0;
   // Motion term e_M (beyond the paper, docs/global_opt.md "Motion term"): in every round, each
   // three consecutive keyframes' change of body-frame velocity per frame
   // (optim::MotionSmoothnessCost), whitened by the vehicle's acceleration noise per axis of the
@@ -186,6 +202,11 @@ struct GlobalMappingOptions {
   // change in the real KITTI ground truth of sequences 09 and 10 (../shared/data; x 4.0/4.2,
   // y 3.2/3.5, z 8.8/9.1 mm): a car's own motion, not a tuned weight.
   bool use_motion = true;
+  // Surface term e_S (beyond the paper, docs/global_opt.md "Surface term"): in every round,
+  // each visual observation's map point against the LiDAR surface of its keyframe's own scan.
+  bool use_surface = true;
+  // A map point farther than this from its keyframe's surface is not on it (m).
+  double surface_max_distance_m = 0.15;
   Eigen::Vector3d motion_sigma_m = Eigen::Vector3d(0.0041, 0.0034, 0.0090);
   // > 0: the visual term uses a subset of the map points that still gives every keyframe at
   // least this many observations, or all of its own (SelectObservations): the cost of a
@@ -240,6 +261,10 @@ struct GlobalMappingResult {
   // The odometry term: keyframe pairs, the measured per-frame sigmas, and the pairs whose
   // whitened residual ended above the kernel scale (down-weighted: the odometry's steps).
   int64_t odometry_pairs = 0, odometry_gated = 0, odometry_outliers = 0;
+  // Pairs whose sigma the conditioning raised by more than 2x (odometry_conditioning).
+  int64_t odometry_inflated = 0;
+  int64_t surface_constraints = 0;    // e_S of the last round
+  bool odometry_conditioned = false;  // The conditioning of the odometry's frames was used.
   Eigen::Vector3d odometry_sigma_m = Eigen::Vector3d::Zero();  // per frame, camera x, y, z
   Eigen::Vector3d odometry_sigma_deg = Eigen::Vector3d::Zero();
   // The motion term: keyframe triples, and those whose whitened residual ended above the kernel

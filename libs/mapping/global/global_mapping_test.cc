@@ -130,6 +130,7 @@ AblationFigures RunAblation(const SyntheticGlobalOptions& so,
   syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
   GlobalMappingOptions without = Quiet();
   without.use_directions = false;
+  without.use_surface = with.use_surface;
   AblationFigures f;
   f.result_with = OptimizeGlobal(syn.input, with);
   const auto ro = OptimizeGlobal(syn.input, without);
@@ -177,6 +178,9 @@ TEST(GlobalMapping, DirectionPriorsRemoveAYawDriftTheOtherTermsCannot) {
   for (const Source source : {Source::kFree, Source::kPrior}) {
     SCOPED_TRACE(ToString(source));
     GlobalMappingOptions o = Quiet();
+    // In this model the scans and the map points agree with the drifted prior by construction;
+    // e_S, which ties the points to the scans, adds to that agreement and is left out here.
+    o.use_surface = false;
     o.direction_source = source;
     o.direction_sigma_px = 1.0;
     const auto f = RunAblation(so, o);
@@ -198,10 +202,18 @@ TEST(GlobalMapping, DirectionPriorsImproveOnAConsistentDriftingSequence) {
   so.keyframes = 60;
   so.biased_local = false;
   so.yaw_drift = 0.1 * M_PI / 180.0;
-  const auto f = RunAblation(so);
+  // e_D's share, without e_S (which removes much of the same drift, below).
+  GlobalMappingOptions no_surface = Quiet();
+  no_surface.use_surface = false;
+  const auto f = RunAblation(so, no_surface);
   EXPECT_LT(f.with.translation_m, 0.3 * f.prior.translation_m);
   EXPECT_LT(f.with.rotation_deg, 0.3 * f.prior.rotation_deg);
   EXPECT_LT(f.with.translation_m, 0.95 * f.without.translation_m);
+  // The surface term: the map points on the true scans' surfaces fix the scale of the visual
+  // term along the road (0.081 -> 0.032 m without directions when written).
+  const auto s = RunAblation(so);
+  EXPECT_LT(s.without.translation_m, 0.6 * f.without.translation_m);
+  EXPECT_LT(s.with.translation_m, 0.6 * f.with.translation_m);
   EXPECT_GT(f.result_with.direction_rho, 0.5);
   EXPECT_EQ(f.result_with.rounds, 2);
   EXPECT_TRUE(f.result_with.direction_sigma_estimated);
@@ -279,6 +291,24 @@ TEST(GlobalMapping, OdometryTermSmoothsAndLeavesTheOdometrysStepOut) {
       motion_error(without, step_keyframe));
   EXPECT_LT(rms(with), 0.8 * rms(without));
   EXPECT_LT(motion_error(with, step_keyframe), motion_error(without, step_keyframe) + 0.01);
+
+  // The registration's conditioning per odometry frame: the frame of the jump, its smallest
+  // eigenvalue 100x below the drive's median, gets 10x the sigma (the cap).
+  EXPECT_FALSE(with.odometry_conditioned);
+  std::vector<double> conditioning(odometry.size(), 0.05);
+  conditioning[*odometry.IndexOf(step_frame)] = 0.0005;
+  syn.input.odometry_conditioning = conditioning;
+  o.use_odometry = true;
+  const GlobalMappingResult conditioned = OptimizeGlobal(syn.input, o);
+  EXPECT_TRUE(conditioned.odometry_conditioned);
+  EXPECT_EQ(conditioned.odometry_inflated, 1);
+  o.odometry_conditioning = false;
+  const GlobalMappingResult ignored = OptimizeGlobal(syn.input, o);
+  EXPECT_FALSE(ignored.odometry_conditioned);
+  EXPECT_EQ(ignored.odometry_inflated, 0);
+  // A conditioning that does not match the odometry's frames is refused.
+  syn.input.odometry_conditioning.pop_back();
+  EXPECT_THROW(OptimizeGlobal(syn.input, o), Error);
 }
 
 TEST(GlobalMapping, WeightsFollowTheRuleUnlessGiven) {
@@ -465,6 +495,8 @@ TEST(GlobalMapping, LoopsAddCorrespondencesBetweenTheirTwoEnds) {
       {23, 16, synthetic.truth_keyframes[16].Inverse() * synthetic.truth_keyframes[23], {}});
   GlobalMappingOptions o = Quiet();
   o.use_directions = false;
+  // The loop term alone: with e_S the two ends already agree with the truth to a few mm here.
+  o.use_surface = false;
   const GlobalMappingResult with = OptimizeGlobal(synthetic.input, o);
   EXPECT_EQ(with.loops_used, 1);
   EXPECT_GT(with.loop_imls, 100);
