@@ -384,6 +384,14 @@ TEST_F(BadInputTest, TruncatedAndWrongArtifacts) {
               "--local " + In("local.h5") + " --visual " + In("visual.h5") + dirs +
                   " --motion-sigma 4 0 9 -o " + Bad("x.h5"),
               "--motion-sigma: '0' is not a sigma > 0 in mm");
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + In("visual.h5") + dirs +
+                  " --surface-sigma 0 -o " + Bad("x.h5"),
+              "--surface-sigma must be positive");
+  ExpectError("global_opt",
+              "--local " + In("local.h5") + " --visual " + In("visual.h5") + dirs +
+                  " --odometry-max-inflation 0.5 -o " + Bad("x.h5"),
+              "--odometry-max-inflation must be >= 1");
   ExpectError("evaluate", "--gt " + kRun + "/data/poses/00.txt --est " + Bad("cut_prior.h5"),
               "cut_prior.h5: cannot open HDF5 file");
   ExpectError("make_prior", "-g " + Bad("empty_prior.h5") + " -o " + Bad("x.h5"),

@@ -81,11 +81,11 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
   method.Flag("!--no-surface", o->use_surface,
               "Leave out the surface term e_S (visual map points on their keyframe's LiDAR "
               "surface; beyond the paper; ablation)");
-  method.Add("--surface-sigma", o->joint.surface_sigma_m,
+  method.Add("--surface-sigma", "surface_sigma_m", o->joint.surface_sigma_m,
              "e_S's sigma: a map point's distance to the LiDAR surface, m");
-  method.Add("--surface-max-distance", o->surface_max_distance_m,
+  method.Add("--surface-max-distance", "surface_max_distance_m", o->surface_max_distance_m,
              "e_S: a map point farther than this (m) from its keyframe's surface is left out");
-  method.Add("--surface-cauchy", o->joint.surface_cauchy,
+  method.Add("--surface-cauchy", "surface_cauchy", o->joint.surface_cauchy,
              "Cauchy kernel scale of e_S on its whitened residual (<= 0: none)");
   method.Flag("!--no-motion", o->use_motion,
               "Leave out the motion term e_M (the car's acceleration between three consecutive "
