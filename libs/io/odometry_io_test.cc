@@ -1,5 +1,4 @@
 #include "io/odometry_io.h"
-#include "io/schema_check.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -9,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/check.h"
+#include "io/schema_check.h"
 #include "io/trajectory_io.h"
 
 namespace jvl::io {
@@ -57,6 +57,27 @@ TEST(OdometryIoTest, RoundTripAndTrajectoryReader) {
   ASSERT_EQ(t.size(), 4u);
   EXPECT_NEAR(t.world_from_cam[3].translation().z(), 3.6, 1e-12);
   fs::remove(path);
+}
+
+// The conditioning read for the global optimisation's odometry term: the smallest eigenvalue of
+// registered frames (status 0 ok, 2 degenerate), 0 for the first frame and motion-model frames;
+// nothing from other trajectory files.
+TEST(OdometryIoTest, ConditioningOfRegisteredFramesOnly) {
+  const std::string path = TempPath("jvl_odom_cond_");
+  OdometryArtifact a = MakeArtifact(4);
+  a.diagnostics.status = {1, 0, 2, 3};
+  a.diagnostics.min_eigenvalue = {0.0, 0.03, 0.001, 0.02};
+  WriteOdometryArtifact(path, a, Provenance());
+  EXPECT_EQ(ReadOdometryConditioning(path), (std::vector<double>{0.0, 0.03, 0.001, 0.0}));
+  const std::string other = TempPath("jvl_odom_cond_traj_");
+  WriteTrajectoryArtifact(other, a.trajectory, Provenance());
+  EXPECT_TRUE(ReadOdometryConditioning(other).empty());
+  const std::string kitti = other + ".txt";
+  WriteTrajectoryKitti(kitti, a.trajectory);
+  EXPECT_TRUE(ReadOdometryConditioning(kitti).empty());
+  fs::remove(path);
+  fs::remove(other);
+  fs::remove(kitti);
 }
 
 TEST(OdometryIoTest, MismatchedDiagnosticsRejected) {

@@ -133,8 +133,10 @@ void CheckInput(const JointProblemInput& input) {
   CheckResiduals(input);
 }
 
+// `kept` receives the (keyframe, map point) pairs that entered the visual term, sorted.
 void AddVisual(const JointProblemInput& input, const JointProblemOptions& options,
-               ceres::LossFunction* loss, JointProblem& jp) {
+               ceres::LossFunction* loss, JointProblem& jp,
+               std::vector<std::pair<int64_t, int32_t>>* kept) {
   const auto& observations = input.Observations();
   // First pass: which observations enter (in front of the camera, within the gate).
   std::vector<char> keep(observations.size(), 0);
@@ -217,6 +219,7 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
             : VisualReprojectionCost::Create(input.camera, obs.uv, 1.0 / sigma,
                                              input.camera_offset);
     jp.visual_blocks.push_back(jp.problem->AddResidualBlock(cost, loss, pose, point));
+    kept->emplace_back(obs.keyframe, obs.map_point);
     used[obs.map_point] = true;
   }
   for (size_t i = 0; i < used.size(); ++i) {
@@ -377,7 +380,9 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
   std::unique_ptr<ceres::LossFunction> imls_loss(MakeLoss(jp.weights.beta, options.imls_huber));
   std::unique_ptr<ceres::LossFunction> direction_loss(
       MakeLoss(jp.weights.gamma, options.direction_huber));
-  AddVisual(input, options, visual_loss.get(), jp);
+  std::vector<std::pair<int64_t, int32_t>> visual_pairs;
+  AddVisual(input, options, visual_loss.get(), jp, &visual_pairs);
+  std::sort(visual_pairs.begin(), visual_pairs.end());
   AddImls(input, options, imls_loss.get(), jp);
   AddDirections(input, options, direction_loss.get(), jp);
   if (!jp.visual_blocks.empty()) visual_loss.release();
@@ -406,21 +411,24 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
     }
   }
 
-  // e_S: whitened, weight 1, Cauchy kernel; only on points that the visual term holds (a point
-  // alone with its surface distance would be free along the surface).
+  // e_S: whitened, weight 1, Cauchy kernel; only on observations that entered the visual term
+  // and on free points (a point alone with its surface distance would be free along the
+  // surface; a point held constant, as weak or by optimize_map_points = false, would pull the
+  // pose towards the place it was put).
   if (!input.point_surfaces.empty()) {
-    ceres::LossFunction* surface_loss =
-        options.surface_cauchy > 0 ? new ceres::CauchyLoss(options.surface_cauchy) : nullptr;
-    bool used_loss = false;
+    std::unique_ptr<ceres::LossFunction> surface_loss(
+        options.surface_cauchy > 0 ? new ceres::CauchyLoss(options.surface_cauchy) : nullptr);
     for (const PointSurfaceConstraint& c : input.point_surfaces) {
       double* point = jp.map_points[static_cast<size_t>(c.map_point)].data();
-      if (!jp.problem->HasParameterBlock(point)) continue;
+      if (!std::binary_search(visual_pairs.begin(), visual_pairs.end(),
+                              std::make_pair(c.keyframe, c.map_point)) ||
+          jp.problem->IsParameterBlockConstant(point))
+        continue;
       jp.surface_blocks.push_back(jp.problem->AddResidualBlock(
           PointToSurfaceCost::Create(c.k_p_y, c.k_normal, 1.0 / options.surface_sigma_m),
-          surface_loss, jp.poses.at(c.keyframe).data(), point));
-      used_loss = true;
+          surface_loss.get(), jp.poses.at(c.keyframe).data(), point));
     }
-    if (!used_loss) delete surface_loss;
+    if (!jp.surface_blocks.empty()) surface_loss.release();
   }
 
   // Gauge: the fixed keyframes, or the first one (six degrees of freedom; LiDAR fixes scale).

@@ -467,8 +467,15 @@ TEST(JointProblem, SurfaceTermFixesTheSpacingInACorridorTheScansCannotSee) {
   lone.map_points.push_back(Eigen::Vector3d(8, 0, 10));
   lone.point_surfaces.push_back({1, static_cast<int32_t>(lone.map_points.size() - 1),
                                  Eigen::Vector3d(8, 0, 8), Eigen::Vector3d(-1, 0, 0)});
+  // So is one of a keyframe that does not observe the point in the visual term (point 0 is
+  // seen by keyframes 0-2 only).
+  lone.point_surfaces.push_back({10, 0, Eigen::Vector3d(8, 0, 8), Eigen::Vector3d(-1, 0, 0)});
   JointProblem built = BuildJointProblem(lone, {});
   EXPECT_EQ(built.surface_blocks.size(), in.point_surfaces.size());
+  // Points held constant get none: they would pull the poses to where they were put.
+  JointProblemOptions held;
+  held.optimize_map_points = false;
+  EXPECT_TRUE(BuildJointProblem(in, held).surface_blocks.empty());
 }
 
 }  // namespace

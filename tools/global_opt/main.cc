@@ -130,8 +130,8 @@ int main(int argc, char** argv) {
       }
       if (o.use_odometry && o.odometry_conditioning && conditioning.empty())
         spdlog::info(
-            "odometry term: the odometry is no lidar_odom artifact; every frame gets "
-            "the drive's sigma (no registration conditioning)");
+            "odometry term: no lidar_odom artifact given (--odometry, or --prior); every frame "
+            "gets the drive's sigma (no registration conditioning)");
       o.joint.octave_scale_factor = visual.scale_factor;
       input = mapping::AssembleGlobalInput(visual, std::move(local),
                                            directions_path.empty() ? nullptr : &directions);

@@ -159,8 +159,11 @@ void GlobalMappingOptions::Check() const {
   JVL_CHECK(std::isfinite(odometry_gate), "odometry_gate must be finite");
   JVL_CHECK(std::isfinite(odometry_max_inflation) && odometry_max_inflation >= 1,
             "odometry_max_inflation must be >= 1, got " << odometry_max_inflation);
-  JVL_CHECK(std::isfinite(surface_max_distance_m) && surface_max_distance_m > 0,
-            "surface_max_distance_m must be > 0, got " << surface_max_distance_m);
+  JVL_CHECK(std::isfinite(surface_max_distance_m) && surface_max_distance_m > 0 &&
+                surface_max_distance_m <= traversal.association.search_radius,
+            "surface_max_distance_m must be in (0, " << traversal.association.search_radius
+                                                     << "] m (the IMLS search radius), got "
+                                                     << surface_max_distance_m);
   JVL_CHECK(motion_sigma_m.allFinite() && motion_sigma_m.minCoeff() > 0,
             "motion_sigma_m must be finite and > 0");
   JVL_CHECK(
@@ -439,7 +442,9 @@ void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
   term->entered = true;
   if (odometry.empty()) return;
   const std::vector<double> factor = OdometryVarianceFactors(conditioning, options);
-  result->odometry_conditioned = options.odometry_conditioning && !conditioning.empty();
+  result->odometry_conditioned =
+      options.odometry_conditioning &&
+      std::any_of(conditioning.begin(), conditioning.end(), [](double c) { return c > 0; });
   std::vector<optim::RelativePoseConstraint> pairs;
   std::vector<double> scale;
   std::vector<double> inflation;

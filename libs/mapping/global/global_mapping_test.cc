@@ -293,15 +293,19 @@ TEST(GlobalMapping, OdometryTermSmoothsAndLeavesTheOdometrysStepOut) {
   EXPECT_LT(motion_error(with, step_keyframe), motion_error(without, step_keyframe) + 0.01);
 
   // The registration's conditioning per odometry frame: the frame of the jump, its smallest
-  // eigenvalue 100x below the drive's median, gets 10x the sigma (the cap).
+  // eigenvalue 100x below the drive's median, gets 10x the sigma (the cap), and so does the last
+  // frame, not registered (0). A pair of keyframes takes the frames after its first keyframe up
+  // to its second: the last frame belongs to the last pair (a pair that took the frames from
+  // its first keyframe on would leave it out and inflate one pair only).
   EXPECT_FALSE(with.odometry_conditioned);
   std::vector<double> conditioning(odometry.size(), 0.05);
   conditioning[*odometry.IndexOf(step_frame)] = 0.0005;
+  conditioning.back() = 0.0;
   syn.input.odometry_conditioning = conditioning;
   o.use_odometry = true;
   const GlobalMappingResult conditioned = OptimizeGlobal(syn.input, o);
   EXPECT_TRUE(conditioned.odometry_conditioned);
-  EXPECT_EQ(conditioned.odometry_inflated, 1);
+  EXPECT_EQ(conditioned.odometry_inflated, 2);
   o.odometry_conditioning = false;
   const GlobalMappingResult ignored = OptimizeGlobal(syn.input, o);
   EXPECT_FALSE(ignored.odometry_conditioned);
