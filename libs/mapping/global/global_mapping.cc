@@ -833,6 +833,26 @@ std::vector<optim::PointSurfaceConstraint> SurfaceConstraints(
   return out;
 }
 
+// e_S of this round (GlobalMappingOptions::use_surface), at the round's poses and map points;
+// before SetImlsTerm, which releases the scans after the last round's traversal.
+void SetSurfaceTerm(int round, const GlobalMapInput& input, const GlobalMappingOptions& options,
+                    optim::JointProblemInput* problem, GlobalMappingResult* result) {
+  problem->point_surfaces.clear();
+  if (!options.use_surface) return;
+  if (input.scans.empty()) {
+    if (round == 0) spdlog::info("surface term left out: the local map holds no scans");
+    return;
+  }
+  lidar::AssociationOptions association = options.traversal.association;
+  association.max_distance = options.surface_max_distance_m;
+  problem->point_surfaces =
+      SurfaceConstraints(result->keyframes, input.scans, input.observations, problem->map_points,
+                         association, options.solve.threads);
+  result->surface_constraints = static_cast<int64_t>(problem->point_surfaces.size());
+  spdlog::info("surface term: {} map point observations on their keyframe's scan",
+               problem->point_surfaces.size());
+}
+
 // e_L (Eq. 3-4) of this round: the saved set L and, with a fresh traversal, Eq. (3) against the
 // current poses (the paper's single traversal in round 0). The scans are released after the
 // last traversal (on a long sequence they are a large part of the memory).
@@ -975,19 +995,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
     for (size_t i = 0; i < result.keyframes.size(); ++i)
       problem.poses[static_cast<int64_t>(i)] = result.keyframes.world_from_cam[i];
     SetDirectionTerm(round, terms, input.camera, options, &direction, &joint, &problem, &result);
-    problem.point_surfaces.clear();
-    if (options.use_surface && !input.scans.empty()) {
-      lidar::AssociationOptions association = options.traversal.association;
-      association.max_distance = options.surface_max_distance_m;
-      problem.point_surfaces =
-          SurfaceConstraints(result.keyframes, input.scans, input.observations, problem.map_points,
-                             association, options.solve.threads);
-      result.surface_constraints = static_cast<int64_t>(problem.point_surfaces.size());
-      spdlog::info("surface term: {} map point observations on their keyframe's scan",
-                   problem.point_surfaces.size());
-    } else if (options.use_surface && round == 0) {
-      spdlog::info("surface term left out: the local map holds no scans");
-    }
+    SetSurfaceTerm(round, input, options, &problem, &result);
     SetImlsTerm(round, terms, options, &input, &problem, &result);
     SetOdometryTerm(round, input, options, &odometry, &problem, &result);
     const auto direction_before = DirectionCostBefore(round, terms, problem, joint, options);
