@@ -32,15 +32,30 @@ def suffix(name, names):
     return "" if len(names) == 1 else "_" + name
 
 
+def estimated_span(data, name):
+    """First and last frame that any estimate has in sequence `name` (None if not known)."""
+    frames = [f for est in data["estimates"] for seq in est["sequences"] if seq["name"] == name
+              for f in seq.get("est_frames", [])]
+    return (min(frames), max(frames)) if frames else None
+
+
 def plot_top_view(data, name, path):
     fig, ax = plt.subplots(figsize=(8, 8))
     gt_drawn = False
+    # The ground truth only where the estimates are (an excerpt of a long sequence is not
+    # squeezed into a corner of the whole drive).
+    span = estimated_span(data, name)
     for est in data["estimates"]:
         for seq in est["sequences"]:
             if seq["name"] != name:
                 continue
             if not gt_drawn:
                 gt = np.asarray(seq["gt_xyz"])
+                gt_frames = seq.get("gt_frames", [])
+                if span and len(gt_frames) == len(gt):
+                    keep = [span[0] <= f <= span[1] for f in gt_frames]
+                    if any(keep):
+                        gt = gt[np.asarray(keep)]
                 ax.plot(gt[:, 0], gt[:, 2], "k-", lw=2.0, label="ground truth")
                 ax.plot(gt[0, 0], gt[0, 2], "ko", ms=6)
                 gt_drawn = True
@@ -59,7 +74,8 @@ def plot_top_view(data, name, path):
     plt.close(fig)
 
 
-LOOP_STYLE = {"LiDAR": ("tab:red", "x"), "visual": ("tab:blue", "+"), "both": ("tab:purple", "o")}
+LOOP_STYLE = {"LiDAR": ("tab:red", "x"), "visual": ("tab:blue", "+"),
+              "proximity": ("tab:olive", "^"), "both": ("tab:purple", "o")}
 
 
 def plot_loops(data, name, ax):

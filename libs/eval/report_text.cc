@@ -172,18 +172,23 @@ nlohmann::json PlotData(const std::vector<EstimateEval>& estimates, const EvalOp
     }
     for (const SequenceEval& s : e.sequences) {
       nlohmann::json js = {{"name", s.name}};
-      nlohmann::json gt = nlohmann::json::array(), est = nlohmann::json::array();
+      nlohmann::json gt = nlohmann::json::array(), est = nlohmann::json::array(),
+                     est_frames = nlohmann::json::array();
       auto xyz = [&s](const Eigen::Matrix4d& pose) {
         const Eigen::Vector4d p = s.world_from_origin * pose.col(3);
         return nlohmann::json::array({p.x(), p.y(), p.z()});
       };
       for (size_t i = 0; i < s.paired.size(); ++i) {
         gt.push_back(xyz(s.paired.gt[i]));
-        if (s.paired.has_est[i]) est.push_back(xyz(s.paired.est[i]));
+        if (s.paired.has_est[i]) {
+          est.push_back(xyz(s.paired.est[i]));
+          est_frames.push_back(s.paired.frames[i]);
+        }
       }
       js["gt_frames"] = s.paired.frames;
       js["gt_xyz"] = std::move(gt);
       js["est_xyz"] = std::move(est);
+      js["est_frames"] = std::move(est_frames);
       js["ape_frames"] = s.ape.frames;
       js["ape_translation_m"] = s.ape.translation_m;
       je["sequences"].push_back(std::move(js));

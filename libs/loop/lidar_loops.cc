@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "core/check.h"
@@ -44,6 +45,10 @@ void LidarLoopOptions::Check() const {
                 << consistency_m << " and " << consistency_deg);
   JVL_CHECK(consistency_keyframes >= 0,
             "consistency_keyframes must be >= 0, got " << consistency_keyframes);
+  JVL_CHECK(std::isfinite(proximity_radius_m) && proximity_radius_m > 0 &&
+                std::isfinite(proximity_drift) && proximity_drift >= 0,
+            "proximity_radius_m must be > 0 and proximity_drift >= 0, got "
+                << proximity_radius_m << " and " << proximity_drift);
 }
 
 const char* ToString(LoopStatus status) {
@@ -161,6 +166,14 @@ std::shared_ptr<const LoopScan> LoopScanCache::Get(int64_t frame) {
   return slot->scan;
 }
 
+void LoopScanCache::Prepare(std::vector<int64_t> frames, int threads) {
+  std::sort(frames.begin(), frames.end());
+  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+  if (frames.size() > capacity_) frames.resize(capacity_);
+  ParallelFor(static_cast<int64_t>(frames.size()), threads,
+              [&](int64_t i) { Get(frames[static_cast<size_t>(i)]); });
+}
+
 LoopStatus RegistrationStatus(const lidar::RegistrationResult& reg, const LidarLoopOptions& o) {
   if (!reg.ok || !reg.converged || reg.degenerate) return LoopStatus::kRegistrationFailed;
   if (reg.residual > o.max_residual || reg.correspondences < o.min_correspondences)
@@ -198,8 +211,78 @@ bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, si
   return apart > o.max_prior_offset + o.max_prior_drift * (path[q] - path[m]);
 }
 
+namespace {
+
+// Temporal consistency: a verified match is accepted when the consistency - 1 keyframes before
+// its query have verified matches too, each within consistency_keyframes keyframes of the next
+// one's and agreeing with it in geometry: the relative pose of the later loop predicted from the
+// earlier one and the trajectory's motion between the two queries and between the two matches
+// (a few metres each, where odometry is accurate) must be within consistency_m and
+// consistency_deg of the registered one. A street end registered the wrong way round, or a
+// registration slid along a street, among right ones is not a loop. verified[v]: the candidate
+// of keyframe to_verify[v] with the match keyframe chosen[v].
+void ApplyTemporalConsistency(const Trajectory& keyframes, const std::vector<size_t>& to_verify,
+                              const std::vector<size_t>& chosen, const LidarLoopOptions& o,
+                              std::vector<LoopCandidate>* verified_out) {
+  std::vector<LoopCandidate>& verified = *verified_out;
+  const size_t n = keyframes.size();
+  std::vector<std::optional<size_t>> match_of(n);  // Keyframe index of a verified match.
+  std::vector<Rigid3d> loop_of(n);                 // Its registered match_from_query.
+  for (size_t v = 0; v < verified.size(); ++v) {
+    if (verified[v].status != LoopStatus::kAccepted) continue;
+    match_of[to_verify[v]] = chosen[v];
+    loop_of[to_verify[v]] = verified[v].match_from_query;
+  }
+  const std::vector<Rigid3d>& pose = keyframes.world_from_cam;  // Only relative motions used.
+  for (size_t v = 0; v < verified.size(); ++v) {
+    LoopCandidate& c = verified[v];
+    if (c.status != LoopStatus::kAccepted) continue;
+    const size_t q = to_verify[v];
+    bool consistent = q + 1 >= static_cast<size_t>(o.consistency);
+    for (int back = 1; consistent && back < o.consistency; ++back) {
+      const size_t q2 = q - back + 1, q1 = q - back;
+      const auto& now = match_of[q2];
+      const auto& before = match_of[q1];
+      consistent =
+          now && before &&
+          std::abs(static_cast<long>(*now) - static_cast<long>(*before)) <= o.consistency_keyframes;
+      if (!consistent) break;
+      const Rigid3d off =
+          LoopDisagreement(pose[q1], pose[*before], loop_of[q1], pose[q2], pose[*now], loop_of[q2]);
+      const double off_deg = RotationAngle(off.rotation()) * kRadToDeg;
+      spdlog::debug("consistency {} -> {} after {} -> {}: {:.3f} m, {:.2f} deg",
+                    keyframes.frames[q2], keyframes.frames[*now], keyframes.frames[q1],
+                    keyframes.frames[*before], off.translation().norm(), off_deg);
+      consistent = off.translation().norm() <= o.consistency_m && off_deg <= o.consistency_deg;
+    }
+    if (!consistent) c.status = LoopStatus::kInconsistent;
+  }
+}
+
+// The keyframes to verify: those with a candidate that skip() does not name, and the
+// consistency - 1 keyframes before each (with a candidate), which its temporal consistency
+// looks back to.
+std::vector<size_t> QueriesToVerify(const Trajectory& keyframes,
+                                    const std::function<bool(size_t)>& has_candidate,
+                                    const std::function<bool(int64_t)>& skip, int consistency) {
+  const size_t n = keyframes.size();
+  std::vector<char> verify(n, 0);
+  for (size_t q = 0; q < n; ++q) {
+    if (!has_candidate(q) || (skip && skip(keyframes.frames[q]))) continue;
+    for (size_t back = 0; back < static_cast<size_t>(consistency) && back <= q; ++back)
+      if (has_candidate(q - back)) verify[q - back] = 1;
+  }
+  std::vector<size_t> out;
+  for (size_t q = 0; q < n; ++q)
+    if (verify[q]) out.push_back(q);
+  return out;
+}
+
+}  // namespace
+
 LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
                             const LidarLoopOptions& o, int threads,
+                            const std::function<bool(int64_t)>& skip,
                             const std::function<void()>& tick) {
   o.Check();
   keyframes.Check("loop keyframes");
@@ -272,9 +355,16 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
   }
 
   // Verification of every keyframe's picks (independent, in parallel; results in their slots).
-  std::vector<size_t> to_verify;
-  for (size_t q = 0; q < n; ++q)
-    if (!picks[q].empty()) to_verify.push_back(q);
+  const std::vector<size_t> to_verify = QueriesToVerify(
+      keyframes, [&](size_t q) { return !picks[q].empty(); }, skip, o.consistency);
+  {
+    std::vector<int64_t> frames;
+    for (const size_t q : to_verify) {
+      frames.push_back(keyframes.frames[q]);
+      for (const Pick& pick : picks[q]) frames.push_back(keyframes.frames[pick.match]);
+    }
+    scans.Prepare(std::move(frames), threads);
+  }
   std::vector<LoopCandidate> verified(to_verify.size());
   std::vector<size_t> chosen(to_verify.size());  // Keyframe index of each verified match.
   const Rigid3d& cam0_from_velo = scans.calibration().cam0_from_velo;
@@ -330,44 +420,67 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
     if (tick) tick();
   });
 
-  // Temporal consistency: a verified match is accepted when the consistency - 1 keyframes
-  // before its query have verified matches too, each within consistency_keyframes keyframes of
-  // the next one's and agreeing with it in geometry: the relative pose of the later loop
-  // predicted from the earlier one and the trajectory's motion between the two queries and
-  // between the two matches (a few metres each, where odometry is accurate) must be within
-  // consistency_m and consistency_deg of the registered one. A street end registered the wrong
-  // way round, or a registration slid along a street, among right ones is not a loop.
-  std::vector<std::optional<size_t>> match_of(n);  // Keyframe index of a verified match.
-  std::vector<Rigid3d> loop_of(n);                 // Its registered match_from_query.
-  for (size_t v = 0; v < verified.size(); ++v) {
-    if (verified[v].status != LoopStatus::kAccepted) continue;
-    match_of[to_verify[v]] = chosen[v];
-    loop_of[to_verify[v]] = verified[v].match_from_query;
-  }
-  const std::vector<Rigid3d>& pose = keyframes.world_from_cam;  // Only relative motions used.
-  for (size_t v = 0; v < verified.size(); ++v) {
-    LoopCandidate& c = verified[v];
-    if (c.status != LoopStatus::kAccepted) continue;
-    const size_t q = to_verify[v];
-    bool consistent = q + 1 >= static_cast<size_t>(o.consistency);
-    for (int back = 1; consistent && back < o.consistency; ++back) {
-      const size_t q2 = q - back + 1, q1 = q - back;
-      const auto& now = match_of[q2];
-      const auto& before = match_of[q1];
-      consistent =
-          now && before &&
-          std::abs(static_cast<long>(*now) - static_cast<long>(*before)) <= o.consistency_keyframes;
-      if (!consistent) break;
-      const Rigid3d off =
-          LoopDisagreement(pose[q1], pose[*before], loop_of[q1], pose[q2], pose[*now], loop_of[q2]);
-      const double off_deg = RotationAngle(off.rotation()) * kRadToDeg;
-      spdlog::debug("consistency {} -> {} after {} -> {}: {:.3f} m, {:.2f} deg",
-                    keyframes.frames[q2], keyframes.frames[*now], keyframes.frames[q1],
-                    keyframes.frames[*before], off.translation().norm(), off_deg);
-      consistent = off.translation().norm() <= o.consistency_m && off_deg <= o.consistency_deg;
+  ApplyTemporalConsistency(keyframes, to_verify, chosen, o, &verified);
+  result.candidates = std::move(verified);
+  return result;
+}
+
+LoopResult DetectProximityLoops(const Trajectory& keyframes, LoopScanCache& scans,
+                                const LidarLoopOptions& o, int threads,
+                                const std::function<bool(int64_t)>& skip,
+                                const std::function<void()>& tick) {
+  o.Check();
+  keyframes.Check("loop keyframes");
+  const size_t n = keyframes.size();
+  LoopResult result;
+  result.keyframes = keyframes.frames;
+  const std::vector<double> path = PathLengths(keyframes);
+  const std::vector<Rigid3d>& pose = keyframes.world_from_cam;
+  // The candidate of every keyframe: the nearest earlier keyframe within the bound (ties: the
+  // earlier one).
+  std::vector<std::optional<size_t>> candidate(n);
+  for (size_t q = 0; q < n; ++q) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j < q && path[q] - path[j] >= o.min_separation_m; ++j) {
+      const double apart = (pose[q].translation() - pose[j].translation()).norm();
+      if (apart <= o.proximity_radius_m + o.proximity_drift * (path[q] - path[j]) &&
+          apart < nearest) {
+        nearest = apart;
+        candidate[q] = j;
+      }
     }
-    if (!consistent) c.status = LoopStatus::kInconsistent;
   }
+  const std::vector<size_t> to_verify = QueriesToVerify(
+      keyframes, [&](size_t q) { return candidate[q].has_value(); }, skip, o.consistency);
+  std::vector<size_t> chosen;
+  std::vector<int64_t> frames;
+  for (const size_t q : to_verify) {
+    chosen.push_back(*candidate[q]);
+    frames.push_back(keyframes.frames[q]);
+    frames.push_back(keyframes.frames[*candidate[q]]);
+  }
+  scans.Prepare(std::move(frames), threads);
+  std::vector<LoopCandidate> verified(to_verify.size());
+  ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t v) {
+    const size_t q = to_verify[static_cast<size_t>(v)], m = chosen[static_cast<size_t>(v)];
+    LoopCandidate c;
+    c.query = keyframes.frames[q];
+    c.match = keyframes.frames[m];
+    c.detector = "proximity";
+    const Rigid3d initial = pose[m].Inverse() * pose[q];
+    c.yaw_rad = RelativeHeading(initial);
+    const lidar::RegistrationResult reg =
+        RegisterLoopScans(*scans.Get(c.query), *scans.Get(c.match), initial, o);
+    c.status = RegistrationStatus(reg, o);
+    c.match_from_query = reg.world_from_scan;
+    c.correspondences = reg.correspondences;
+    c.residual = reg.residual;
+    c.converged = reg.converged;
+    c.degenerate = reg.degenerate;
+    verified[static_cast<size_t>(v)] = c;
+    if (tick) tick();
+  });
+  ApplyTemporalConsistency(keyframes, to_verify, chosen, o, &verified);
   result.candidates = std::move(verified);
   return result;
 }

@@ -5,7 +5,9 @@
 // on the trajectory's drift, and temporal consistency over consecutive keyframes, in geometry.
 // One of the loop stage's detectors (loop_detect); it never looks at the trajectory's positions
 // to find a candidate, only at its path length to skip the keyframes just driven and at its
-// motion between consecutive keyframes to check that consecutive loops agree.
+// motion between consecutive keyframes to check that consecutive loops agree. The proximity
+// detector (DetectProximityLoops), here too, does: the same verification on the trajectory's
+// nearest earlier keyframe.
 #pragma once
 
 #include <cstdint>
@@ -69,6 +71,11 @@ struct LidarLoopOptions {
   // ... and agreeing in geometry (see DetectLidarLoops) within these.
   double consistency_m = 1.0;
   double consistency_deg = 3.0;
+  // The proximity detector (DetectProximityLoops): candidates are the earlier keyframes (at
+  // least min_separation_m back along the path) within proximity_radius_m +
+  // proximity_drift x (path length between them) of the query in the trajectory given.
+  double proximity_radius_m = 10.0;
+  double proximity_drift = 0.02;
   void Check() const;
 };
 
@@ -81,7 +88,7 @@ enum class LoopStatus : int32_t {
   kFarInPrior = 5,          // The trajectory puts the two keyframes too far apart.
   kFewInliers = 6,          // Visual: too few 3D-2D matches agree on one relative pose.
   kDisagree = 7,            // Visual: the scan registration moved far from the image's pose.
-  kDuplicate = 8,           // Accepted, but the LiDAR detector closed the same query already.
+  kDuplicate = 8,           // Accepted, but an earlier detector closed the same query already.
 };
 const char* ToString(LoopStatus status);
 
@@ -124,9 +131,26 @@ class LoopScanCache;
 // for the preprocessing (the descriptor is computed in the velodyne frame). tick() is called
 // once per keyframe described and once per candidate verified (progress). scans: the prepared
 // scans of the verification (prepared with these options), shared with the visual detector.
+// skip(frame): queries not to verify (closed by a detector run before); the consistency - 1
+// keyframes before a query that is verified are verified too (its temporal consistency needs
+// them).
 LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
                             const LidarLoopOptions& options, int threads,
+                            const std::function<bool(int64_t)>& skip = nullptr,
                             const std::function<void()>& tick = nullptr);
+
+// The proximity detector (beyond the paper; LiDAR SLAM systems search loop candidates this
+// way): the trajectory's nearest earlier keyframe within the proximity bound is the candidate,
+// the query's scan is registered on its scan from the trajectory's relative pose (the coarse
+// pass, then the normal one), and the LiDAR detector's bounds and temporal consistency decide.
+// It closes what a place descriptor cannot: a street driven the other way round on the other
+// lane. It relies on the trajectory's positions, so its recall falls with the drift where the
+// descriptors' does not. skip(frame): queries not to verify (closed by another detector); a
+// query that is verified has the consistency - 1 keyframes before it verified too.
+LoopResult DetectProximityLoops(const Trajectory& keyframes, LoopScanCache& scans,
+                                const LidarLoopOptions& options, int threads,
+                                const std::function<bool(int64_t)>& skip = nullptr,
+                                const std::function<void()>& tick = nullptr);
 
 // The verification shared by both detectors. A keyframe's scan preprocessed as lidar_odom does
 // it (cam0 frame) and its surface, as IMLS-SLAM sampling lists: the points registered as the
@@ -173,6 +197,10 @@ class LoopScanCache {
   LoopScanCache(std::function<PointCloud(int64_t)> load_scan, const Calibration& calibration,
                 const LidarLoopOptions& options, size_t capacity = 1024);
   std::shared_ptr<const LoopScan> Get(int64_t frame);
+  // Prepares the scans of `frames` (repeats allowed; at most `capacity` of them) on `threads`
+  // threads before a verification needs them: each is prepared once, in parallel, instead of
+  // two verifications waiting on the same scan.
+  void Prepare(std::vector<int64_t> frames, int threads);
   PointCloud Load(int64_t frame) const { return load_scan_(frame); }  // As read, not cached.
   const LidarLoopOptions& options() const { return options_; }        // The preparation's.
   const Calibration& calibration() const { return calibration_; }

@@ -1,14 +1,18 @@
 #include "loop/visual_loops.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <optional>
 
 #include "core/check.h"
 #include "core/threads.h"
+#include "core/timer.h"
 
 namespace jvl::loop {
 
@@ -16,8 +20,6 @@ void VisualLoopOptions::Check() const {
   orb.Check();
   lidar.Check();
   JVL_CHECK(camera >= 0 && camera < 4, "--camera " << camera << " is not a camera (0..3)");
-  JVL_CHECK(std::isfinite(min_separation_m) && min_separation_m >= 0,
-            "min_separation_m must be >= 0, got " << min_separation_m);
   JVL_CHECK(group_keyframes >= 0, "group_keyframes must be >= 0, got " << group_keyframes);
   JVL_CHECK(min_common_ratio > 0 && min_common_ratio <= 1,
             "min_common_ratio must be in (0, 1], got " << min_common_ratio);
@@ -126,11 +128,14 @@ double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoop
   return count >= 2 && z <= o.max_depth_m ? z : 0;
 }
 
-}  // namespace
-
-LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
-                                    int64_t query_frame, int64_t match_frame, LoopScanCache& scans,
-                                    const VisualLoopOptions& o) {
+// The images' part of a verification: keypoints matched, their depth from the match keyframe's
+// scan, PnP. The candidate with its inliers (status kFewInliers); *image_pose = match_from_query
+// when PnP found one with at least min_inliers.
+LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
+                                   int64_t match_frame, LoopScanCache& scans,
+                                   const VisualLoopOptions& o,
+                                   std::optional<Rigid3d>* image_pose_out) {
+  image_pose_out->reset();
   const Calibration& calibration = scans.calibration();
   LoopCandidate c;
   c.detector = "visual";
@@ -181,7 +186,18 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
       choice.camera_from_cam0().Inverse() *
       Rigid3d(Eigen::Quaterniond(rotation).normalized(), translation).Inverse() *
       choice.camera_from_cam0();
+  *image_pose_out = image_pose;
+  return c;
+}
 
+// The scans' part: the query's scan registered on the match's from the image's pose, the bounds,
+// and the points kept.
+void RegisterVisualCandidate(const Rigid3d& image_pose, int64_t query_frame, int64_t match_frame,
+                             LoopScanCache& scans, const VisualLoopOptions& o, LoopCandidate* out) {
+  LoopCandidate& c = *out;
+  const Calibration& calibration = scans.calibration();
+  const PinholeCamera camera = calibration.Camera(o.camera);
+  const CameraChoice choice = CameraChoice::Of(calibration, o.camera);
   const lidar::RegistrationResult reg =
       RegisterLoopScans(*scans.Get(query_frame), *scans.Get(match_frame), image_pose, o.lidar);
   c.match_from_query = reg.ok ? reg.world_from_scan : image_pose;
@@ -212,6 +228,16 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
   c.points = std::move(kept);
   // Heading of the query relative to the match (about the camera's vertical, left positive).
   c.yaw_rad = RelativeHeading(c.match_from_query);
+}
+
+}  // namespace
+
+LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
+                                    int64_t query_frame, int64_t match_frame, LoopScanCache& scans,
+                                    const VisualLoopOptions& o) {
+  std::optional<Rigid3d> image_pose;
+  LoopCandidate c = MatchVisualCandidate(query, match, match_frame, scans, o, &image_pose);
+  if (image_pose) RegisterVisualCandidate(*image_pose, query_frame, match_frame, scans, o, &c);
   return c;
 }
 
@@ -226,12 +252,15 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
   LoopResult result;
   result.keyframes = keyframes.frames;
   const std::vector<double> path = PathLengths(keyframes);
+  Timer timer;
   std::vector<VisualKeyframe> described(n);
   ParallelFor(static_cast<int64_t>(n), threads, [&](int64_t i) {
     described[static_cast<size_t>(i)] =
         DescribeFeatures(features_of(keyframes.frames[static_cast<size_t>(i)]), vocabulary, o);
     if (tick) tick();
   });
+  spdlog::debug("visual detector: {} keyframes described in {:.2f} s", n, timer.ElapsedSeconds());
+  timer.Reset();
 
   // Inverted index: word -> keyframes holding it, filled as the queries advance (a query sees
   // only the keyframes before it).
@@ -261,12 +290,12 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
       for (const size_t j : inverted[static_cast<size_t>(word)]) ++common[j];
     int most = 0;
     for (size_t j = 0; j < q; ++j)
-      if (path[q] - path[j] >= o.min_separation_m) most = std::max(most, common[j]);
+      if (path[q] - path[j] >= o.lidar.min_separation_m) most = std::max(most, common[j]);
     std::vector<double> score(q, -1);  // >= 0: a candidate.
     if (most > 0) {
       const double least = o.min_common_ratio * most;
       for (size_t j = 0; j < q; ++j) {
-        if (path[q] - path[j] < o.min_separation_m || common[j] < least) continue;
+        if (path[q] - path[j] < o.lidar.min_separation_m || common[j] < least) continue;
         const double s = Vocabulary::Score(bow, described[j].bow);
         if (s >= min_score) score[j] = s;
       }
@@ -312,36 +341,70 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
 
   // Verification (independent, in parallel; results in their slots), then the best accepted
   // candidate per query (most inliers), or the first rejected one.
+  spdlog::debug("visual detector: {} candidates found in {:.2f} s", to_verify.size(),
+                timer.ElapsedSeconds());
+  timer.Reset();
+  // 1. The images of every candidate (in parallel): matching, depth, PnP.
   std::vector<LoopCandidate> verified(to_verify.size());
-  // Latest queries first: the LiDAR detector, verifying in query order, left the scans of its
-  // latest queries and their matches in the shared cache.
-  ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t r) {
-    const int64_t v = static_cast<int64_t>(to_verify.size()) - 1 - r;
-    const auto [q, m] = to_verify[static_cast<size_t>(v)];
-    LoopCandidate c = VerifyVisualCandidate(described[q], described[m], keyframes.frames[q],
-                                            keyframes.frames[m], scans, o);
-    c.query = keyframes.frames[q];
-    c.match = keyframes.frames[m];
-    c.descriptor_distance = to_verify_score[static_cast<size_t>(v)];
-    if (c.status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, m, o.lidar))
-      c.status = LoopStatus::kFarInPrior;
-    verified[static_cast<size_t>(v)] = c;
+  std::vector<std::optional<Rigid3d>> image_pose(to_verify.size());
+  ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t vi) {
+    const size_t v = static_cast<size_t>(vi);
+    const auto [q, m] = to_verify[v];
+    verified[v] = MatchVisualCandidate(described[q], described[m], keyframes.frames[m], scans, o,
+                                       &image_pose[v]);
+    verified[v].query = keyframes.frames[q];
+    verified[v].match = keyframes.frames[m];
+    verified[v].descriptor_distance = to_verify_score[v];
     if (tick) tick();
   });
-  for (size_t v = 0; v < verified.size();) {
+  spdlog::debug("visual detector: {} candidates matched in {:.2f} s", verified.size(),
+                timer.ElapsedSeconds());
+  timer.Reset();
+  // 2. Per query (to_verify runs query by query), the candidates with an image pose, most PnP
+  // inliers first (ties: the order found). The scans of each query's first one are prepared in
+  // parallel.
+  std::vector<std::pair<size_t, size_t>> queries;  // [begin, end) of to_verify.
+  for (size_t v = 0; v < to_verify.size();) {
     size_t end = v;
-    size_t keep = v;
-    while (end < verified.size() && verified[end].query == verified[v].query) {
-      const LoopCandidate& c = verified[end];
-      const LoopCandidate& k = verified[keep];
-      if (c.status == LoopStatus::kAccepted &&
-          (k.status != LoopStatus::kAccepted || c.inliers > k.inliers))
-        keep = end;
-      ++end;
-    }
-    result.candidates.push_back(verified[keep]);
+    while (end < to_verify.size() && to_verify[end].first == to_verify[v].first) ++end;
+    queries.emplace_back(v, end);
     v = end;
   }
+  std::vector<std::vector<size_t>> order(queries.size());
+  std::vector<int64_t> frames;
+  for (size_t g = 0; g < queries.size(); ++g) {
+    for (size_t v = queries[g].first; v < queries[g].second; ++v)
+      if (image_pose[v]) order[g].push_back(v);
+    std::stable_sort(order[g].begin(), order[g].end(),
+                     [&](size_t a, size_t b) { return verified[a].inliers > verified[b].inliers; });
+    if (order[g].empty()) continue;
+    frames.push_back(verified[order[g][0]].query);
+    frames.push_back(verified[order[g][0]].match);
+  }
+  scans.Prepare(std::move(frames), threads);
+  std::vector<LoopCandidate> result_slots(queries.size());
+  // 3. Registered in that order until one is accepted (in parallel over the queries): the
+  // accepted candidate with the most inliers, as if every one had been registered; a query
+  // without one keeps its first candidate.
+  ParallelFor(static_cast<int64_t>(queries.size()), threads, [&](int64_t gi) {
+    const size_t g = static_cast<size_t>(gi);
+    size_t keep = queries[g].first;
+    for (const size_t v : order[g]) {
+      LoopCandidate& c = verified[v];
+      const auto [q, m] = to_verify[v];
+      RegisterVisualCandidate(*image_pose[v], c.query, c.match, scans, o, &c);
+      if (c.status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, m, o.lidar))
+        c.status = LoopStatus::kFarInPrior;
+      if (c.status == LoopStatus::kAccepted) {
+        keep = v;
+        break;
+      }
+    }
+    result_slots[g] = verified[keep];
+  });
+  spdlog::debug("visual detector: {} queries registered in {:.2f} s", queries.size(),
+                timer.ElapsedSeconds());
+  result.candidates = std::move(result_slots);
   return result;
 }
 

@@ -2,12 +2,12 @@
 // and Tardos, IEEE T-RO 2017, Sec. V-A/B), on the keyframes of loop_detect:
 //
 // * Every keyframe image becomes a bag-of-words vector (vocabulary.h) of its ORB features.
-// * Candidates of a query keyframe: the earlier keyframes at least min_separation_m back along the
-//   trajectory's path that share words with it (inverted index), keeping those with at least
-//   min_common_ratio x the largest number of shared words and a score no lower than the query's
-//   lowest score against its own neighbours (the keyframes just before it: ORB-SLAM2's covisible
-//   keyframes). Each candidate forms a group with its neighbours (group_keyframes either side);
-//   the groups' accumulated scores keep those within min_group_ratio of the best.
+// * Candidates of a query keyframe: the earlier keyframes at least lidar.min_separation_m back
+//   along the trajectory's path that share words with it (inverted index), keeping those with at
+//   least min_common_ratio x the largest number of shared words and a score no lower than the
+//   query's lowest score against its own neighbours (the keyframes just before it: ORB-SLAM2's
+//   covisible keyframes). Each candidate forms a group with its neighbours (group_keyframes
+//   either side); the groups' accumulated scores keep those within min_group_ratio of the best.
 // * Temporal consistency: a group is verified once `consistency` consecutive query keyframes have
 //   overlapping groups.
 // * Geometric verification: ORB matches of the two images within the same vocabulary node (ratio
@@ -32,13 +32,12 @@
 namespace jvl::loop {
 
 struct VisualLoopOptions {
-  vision::OrbOptions orb;          // Features of each keyframe image.
-  int camera = 0;                  // The camera of the images (loop_detect --camera).
-  double min_separation_m = 50.0;  // Candidates at least this far back along the path (m).
-  int group_keyframes = 2;         // Neighbours either side: a candidate's group; the query's.
-  double min_common_ratio = 0.8;   // Of the largest number of words shared with the query.
-  double min_group_ratio = 0.75;   // Of the best group's accumulated score.
-  int consistency = 3;             // Consecutive query keyframes with overlapping groups.
+  vision::OrbOptions orb;         // Features of each keyframe image.
+  int camera = 0;                 // The camera of the images (loop_detect --camera).
+  int group_keyframes = 2;        // Neighbours either side: a candidate's group; the query's.
+  double min_common_ratio = 0.8;  // Of the largest number of words shared with the query.
+  double min_group_ratio = 0.75;  // Of the best group's accumulated score.
+  int consistency = 3;            // Consecutive query keyframes with overlapping groups.
   // Matching: within a vocabulary node `match_level` levels below the root, Hamming distance up to
   // max_hamming and below ratio x the second best.
   int match_level = 2;
@@ -58,9 +57,10 @@ struct VisualLoopOptions {
   // Points stored for the global optimisation: inliers within this many sigmas (the pyramid
   // level's scale, px) of their query pixel at the registered pose.
   double point_max_error_sigmas = 2.0;
-  // Registration bounds and the trajectory's drift bound (the LiDAR detector's fields:
-  // preprocess, surface, association, registration, coarse_scale, max_residual,
-  // min_correspondences, max_translation, max_prior_offset, max_prior_drift).
+  // The separation along the path, registration bounds and the trajectory's drift bound: the
+  // LiDAR detector's fields (min_separation_m, preprocess, surface, association, registration,
+  // coarse_scale, max_residual, min_correspondences, max_translation, max_prior_offset,
+  // max_prior_drift), one set for every detector.
   LidarLoopOptions lidar;
   void Check() const;
 };

@@ -598,6 +598,8 @@ TEST_F(BadInputTest, InvalidOptions) {
   ExpectError("loop_detect", loops + " --min-inliers 2", "--min-inliers must be >= 4");
   ExpectError("loop_detect", loops + " --visual-features 0", "--visual-features must be > 0");
   ExpectError("loop_detect", loops + " --detectors lidar,radar", "--detectors");
+  ExpectError("loop_detect", loops + " --proximity-radius 0",
+              "--proximity-radius must be > 0 and --proximity-drift >= 0");
   ExpectError("loop_detect", loops + " --vocabulary " + Bad("no_vocabulary.h5"),
               "no_vocabulary.h5 not found: give one with --vocabulary");
   ExpectError("loop_detect", loops + " --vocabulary " + In("odom.h5"), "odom.h5");

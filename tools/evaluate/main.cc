@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
       nlohmann::json plot_data = jvl::eval::PlotData(run.estimates, c.options);
       if (!loops_path.empty()) {
         tool.AddInput(loops_path, /*same_dataset=*/false);
-        // Accepted loops (status 0) as [query, match, detector]; "both" where the other
+        // Accepted loops (status 0) as [query, match, detector]; "both" where another
         // detector closed the same query too (its loop kept as a duplicate, status 8).
         const jvl::io::LoopsData loops = jvl::io::ReadLoopsArtifact(loops_path);
         nlohmann::json marks = nlohmann::json::array();
@@ -84,7 +84,11 @@ int main(int argc, char** argv) {
           bool both = false;
           for (const jvl::io::LoopRecord& d : loops.loops)
             both |= d.status == 8 && d.query == r.query;
-          marks.push_back({r.query, r.match, both ? "both" : r.detector == 1 ? "visual" : "LiDAR"});
+          marks.push_back({r.query, r.match,
+                           both              ? "both"
+                           : r.detector == 1 ? "visual"
+                           : r.detector == 2 ? "proximity"
+                                             : "LiDAR"});
         }
         plot_data["loops"] = std::move(marks);
       }

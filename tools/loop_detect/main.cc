@@ -54,8 +54,9 @@ Trajectory SelectKeyframes(const Trajectory& poses, const io::Dataset& dataset, 
 // min_separation back along the true path lies within 5 m (same direction: headings within
 // 30 deg; opposite: more than 150 deg apart). A loop is right when its relative pose is within
 // 1 m and 2 deg of the true one.
-// detector: -1 = every accepted loop; 0 / 1 = the loops that detector accepted (a visual loop
-// marked duplicate counts for the visual detector).
+// detector: -1 = every accepted loop; 0 / 1 / 2 = the loops that detector accepted (a loop
+// marked duplicate counts for its detector). A detector run after another verified only the
+// queries left open: run it alone (--detectors) for its own recall.
 void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
                               double min_separation, int detector, const std::string& label) {
   Trajectory kf;
@@ -149,7 +150,7 @@ int main(int argc, char** argv) {
   std::string dataset_dir, frames = ":", poses_path, output, gt_path, csv, visual_path;
   int every = 5;
   int scan_cache = 1024;
-  std::vector<std::string> detectors = {"lidar", "visual"};
+  std::vector<std::string> detectors = {"lidar", "visual", "proximity"};
   std::string vocabulary_path = JVL_DEFAULT_VOCABULARY;
   io::DatasetOptions dataset_options;
   loop::LidarLoopOptions options;
@@ -176,10 +177,13 @@ int main(int argc, char** argv) {
                      "Also write the candidates as CSV (query, match, detector, status, "
                      "scores, registration, relative translation)"));
   cli.add_option("--detectors", detectors,
-                 "Detectors to run: lidar, visual or both (a visual loop whose query the LiDAR "
-                 "detector closed too is kept with status 8, duplicate)")
+                 "Detectors to run (any of visual, lidar, proximity; run in that order, each "
+                 "later one verifying only the queries the ones before it left open). proximity: "
+                 "the trajectory's nearest earlier keyframe, verified by scan registration. A "
+                 "loop whose query an earlier detector closed too is kept with status 8, "
+                 "duplicate")
       ->delimiter(',')
-      ->check(CLI::IsMember({"lidar", "visual"}))
+      ->check(CLI::IsMember({"lidar", "visual", "proximity"}))
       ->capture_default_str();
   cli.add_option("--vocabulary", vocabulary_path,
                  "Vocabulary of the visual detector (vocab_train); the default is the one shipped "
@@ -209,6 +213,11 @@ int main(int argc, char** argv) {
             "Accept a registration with at least this many correspondences");
   lidar.Add("--consistency", "consistency", options.consistency,
             "Accept a loop when this many consecutive keyframes have verified matches that agree");
+  app::OptionGroup proximity(tool, "Proximity detector");
+  proximity.Add("--proximity-radius", "proximity_radius_m", options.proximity_radius_m,
+                "Candidates lie within this distance of the query in the trajectory given (m) ...");
+  proximity.Add("--proximity-drift", "proximity_drift", options.proximity_drift,
+                "... plus this fraction of the path length between them (the trajectory's drift)");
   app::OptionGroup visual(tool, "Visual detector");
   visual.Add("--visual-consistency", "visual_consistency", visual_options.consistency,
              "Verify a candidate group once this many consecutive keyframes have overlapping "
@@ -224,9 +233,10 @@ int main(int argc, char** argv) {
         std::find(detectors.begin(), detectors.end(), "lidar") != detectors.end();
     const bool use_visual =
         std::find(detectors.begin(), detectors.end(), "visual") != detectors.end();
-    // The visual detector shares the LiDAR detector's registration bounds and separation.
+    const bool use_proximity =
+        std::find(detectors.begin(), detectors.end(), "proximity") != detectors.end();
+    // One set of separation, registration and drift bounds for every detector.
     visual_options.lidar = options;
-    visual_options.min_separation_m = options.min_separation_m;
     visual_options.Check();
     std::optional<loop::Vocabulary> vocabulary;
     if (use_visual) {
@@ -276,19 +286,30 @@ int main(int argc, char** argv) {
       release(map.observation_keypoint), release(map.observation_mappoint);
       release(map.covisibility_edges), release(map.covisibility_weight);
     }
-    // The camera is checked before the LiDAR detector's minutes of work.
+    // The camera is checked before any detector's work.
     if (use_visual) dataset->CheckCamera(visual_options.camera);
+    // The detectors in turn: visual, LiDAR, proximity. A later one verifies only the queries
+    // the ones before it left open (and the keyframes before them that its temporal
+    // consistency needs); its loop on a query closed already is kept as a duplicate.
     std::vector<loop::LoopCandidate> candidates;
-    std::vector<int64_t> lidar_closed;  // Queries the LiDAR detector accepted.
-    if (use_lidar) {
-      Progress progress("LiDAR keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
-      const loop::LoopResult result = loop::DetectLidarLoops(
-          keyframes, scans, options, tool.threads(), [&] { progress.Tick(); });
-      for (const loop::LoopCandidate& c : result.candidates) {
+    std::vector<int64_t> closed;  // Queries a detector accepted, sorted.
+    auto is_closed = [&](int64_t query) {
+      return std::binary_search(closed.begin(), closed.end(), query);
+    };
+    auto take = [&](const loop::LoopResult& result) {
+      std::vector<int64_t> closed_now;
+      for (loop::LoopCandidate c : result.candidates) {
+        if (c.status == loop::LoopStatus::kAccepted) {
+          if (is_closed(c.query))
+            c.status = loop::LoopStatus::kDuplicate;
+          else
+            closed_now.push_back(c.query);
+        }
         candidates.push_back(c);
-        if (c.status == loop::LoopStatus::kAccepted) lidar_closed.push_back(c.query);
       }
-    }
+      closed.insert(closed.end(), closed_now.begin(), closed_now.end());
+      std::sort(closed.begin(), closed.end());
+    };
     if (use_visual) {
       std::atomic<int64_t> extracted{0};
       auto features_of = [&](int64_t f) {
@@ -301,21 +322,26 @@ int main(int argc, char** argv) {
         return mapping::KeyframeFeatures(map, it->second.first, it->second.second);
       };
       Progress progress("visual keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
-      const loop::LoopResult result =
-          loop::DetectVisualLoops(keyframes, features_of, scans, *vocabulary, visual_options,
-                                  tool.threads(), [&] { progress.Tick(); });
+      take(loop::DetectVisualLoops(keyframes, features_of, scans, *vocabulary, visual_options,
+                                   tool.threads(), [&] { progress.Tick(); }));
       if (!visual_path.empty())
         spdlog::info("visual detector: features of {} of {} keyframes from {}, {} extracted",
                      static_cast<int64_t>(keyframes.size()) - extracted.load(), keyframes.size(),
                      visual_path, extracted.load());
-      for (loop::LoopCandidate c : result.candidates) {
-        if (c.status == loop::LoopStatus::kAccepted &&
-            std::find(lidar_closed.begin(), lidar_closed.end(), c.query) != lidar_closed.end())
-          c.status = loop::LoopStatus::kDuplicate;
-        candidates.push_back(c);
-      }
     }
-    // By query, the LiDAR detector's candidate first.
+    if (use_lidar) {
+      Progress progress("LiDAR keyframes", static_cast<int64_t>(keyframes.size()), !tool.quiet());
+      const size_t before = candidates.size();
+      take(loop::DetectLidarLoops(keyframes, scans, options, tool.threads(), is_closed,
+                                  [&] { progress.Tick(); }));
+      spdlog::info("LiDAR detector: {} candidates verified", candidates.size() - before);
+    }
+    if (use_proximity) {
+      const size_t before = candidates.size();
+      take(loop::DetectProximityLoops(keyframes, scans, options, tool.threads(), is_closed));
+      spdlog::info("proximity detector: {} candidates verified", candidates.size() - before);
+    }
+    // By query, in the detectors' order (stable).
     std::stable_sort(candidates.begin(), candidates.end(),
                      [](const loop::LoopCandidate& a, const loop::LoopCandidate& b) {
                        return a.query < b.query;
@@ -329,7 +355,7 @@ int main(int argc, char** argv) {
       io::LoopRecord r;
       r.query = c.query;
       r.match = c.match;
-      r.detector = c.detector == "visual" ? 1 : 0;
+      r.detector = c.detector == "visual" ? 1 : c.detector == "proximity" ? 2 : 0;
       r.status = static_cast<int32_t>(c.status);
       r.match_from_query = c.match_from_query;
       r.score = c.descriptor_distance;
@@ -351,9 +377,16 @@ int main(int argc, char** argv) {
                  data.keyframes.size(), data.loops.size(), accepted, output);
     if (!gt_path.empty()) {
       const Trajectory gt = io::ReadTrajectory(gt_path);
-      if (use_lidar) ReportAgainstGroundTruth(gt, data, options.min_separation_m, 0, "LiDAR");
+      // The detectors in the order they ran; a later one verified only the queries left open.
       if (use_visual) ReportAgainstGroundTruth(gt, data, options.min_separation_m, 1, "visual");
-      if (use_lidar && use_visual)
+      if (use_lidar)
+        ReportAgainstGroundTruth(gt, data, options.min_separation_m, 0,
+                                 use_visual ? "LiDAR (after visual)" : "LiDAR");
+      if (use_proximity)
+        ReportAgainstGroundTruth(
+            gt, data, options.min_separation_m, 2,
+            use_visual || use_lidar ? "proximity (after the others)" : "proximity");
+      if (use_lidar + use_visual + use_proximity > 1)
         ReportAgainstGroundTruth(gt, data, options.min_separation_m, -1, "combined");
     }
   });
