@@ -85,6 +85,9 @@ def plot_loops(data, name, ax):
         return
     seq = next(s for e in data["estimates"] for s in e["sequences"] if s["name"] == name)
     where = {f: p for f, p in zip(seq.get("gt_frames", []), seq["gt_xyz"])}
+    span = estimated_span(data, name)
+    if span:  # Only the loops within the frames drawn.
+        where = {f: p for f, p in where.items() if span[0] <= f <= span[1]}
     drawn = set()
     for query, match, detector in loops:
         if query not in where or match not in where:

@@ -28,10 +28,11 @@ struct LoopPointRecord {
 struct LoopRecord {
   int64_t query = 0;         // The later keyframe (dataset frame) ...
   int64_t match = 0;         // ... and the earlier one it was matched to.
-  int32_t detector = 0;      // 0 = LiDAR descriptor, 1 = visual words.
+  int32_t detector = 0;      // 0 = LiDAR descriptor, 1 = visual words, 2 = proximity.
   int32_t status = 0;        // 0 = accepted; > 0: why not (LoopStatus of libs/loop).
   Rigid3d match_from_query;  // cam0 frames.
-  // LiDAR: descriptor distance (0 = identical); visual: bag-of-words score (1 = identical).
+  // LiDAR: descriptor distance (0 = identical); visual: bag-of-words score (1 = identical);
+  // proximity: 0 (none).
   double score = 0;
   double ring_key_distance = 0;
   double yaw_deg = 0;  // Detector's yaw estimate of the query relative to the match.

@@ -166,12 +166,16 @@ std::shared_ptr<const LoopScan> LoopScanCache::Get(int64_t frame) {
   return slot->scan;
 }
 
-void LoopScanCache::Prepare(std::vector<int64_t> frames, int threads) {
-  std::sort(frames.begin(), frames.end());
-  frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
-  if (frames.size() > capacity_) frames.resize(capacity_);
-  ParallelFor(static_cast<int64_t>(frames.size()), threads,
-              [&](int64_t i) { Get(frames[static_cast<size_t>(i)]); });
+void LoopScanCache::Prepare(const std::vector<int64_t>& frames, int threads) {
+  // The first `capacity` distinct frames in the order given (the order they are needed in).
+  std::vector<int64_t> first;
+  std::unordered_map<int64_t, char> seen;
+  for (const int64_t f : frames) {
+    if (first.size() >= capacity_) break;
+    if (seen.emplace(f, 1).second) first.push_back(f);
+  }
+  ParallelFor(static_cast<int64_t>(first.size()), threads,
+              [&](int64_t i) { Get(first[static_cast<size_t>(i)]); });
 }
 
 LoopStatus RegistrationStatus(const lidar::RegistrationResult& reg, const LidarLoopOptions& o) {
@@ -257,6 +261,18 @@ void ApplyTemporalConsistency(const Trajectory& keyframes, const std::vector<siz
     }
     if (!consistent) c.status = LoopStatus::kInconsistent;
   }
+}
+
+// The candidates of the queries skip() does not name: a skipped query was verified only as the
+// look-back of a later one's temporal consistency (its own was not checked against verified
+// keyframes before it).
+std::vector<LoopCandidate> OpenQueries(std::vector<LoopCandidate> verified,
+                                       const std::function<bool(int64_t)>& skip) {
+  if (!skip) return verified;
+  verified.erase(std::remove_if(verified.begin(), verified.end(),
+                                [&](const LoopCandidate& c) { return skip(c.query); }),
+                 verified.end());
+  return verified;
 }
 
 // The keyframes to verify: those with a candidate that skip() does not name, and the
@@ -421,7 +437,7 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
   });
 
   ApplyTemporalConsistency(keyframes, to_verify, chosen, o, &verified);
-  result.candidates = std::move(verified);
+  result.candidates = OpenQueries(std::move(verified), skip);
   return result;
 }
 
@@ -472,6 +488,8 @@ LoopResult DetectProximityLoops(const Trajectory& keyframes, LoopScanCache& scan
     const lidar::RegistrationResult reg =
         RegisterLoopScans(*scans.Get(c.query), *scans.Get(c.match), initial, o);
     c.status = RegistrationStatus(reg, o);
+    if (c.status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, m, o))
+      c.status = LoopStatus::kFarInPrior;
     c.match_from_query = reg.world_from_scan;
     c.correspondences = reg.correspondences;
     c.residual = reg.residual;
@@ -481,7 +499,7 @@ LoopResult DetectProximityLoops(const Trajectory& keyframes, LoopScanCache& scan
     if (tick) tick();
   });
   ApplyTemporalConsistency(keyframes, to_verify, chosen, o, &verified);
-  result.candidates = std::move(verified);
+  result.candidates = OpenQueries(std::move(verified), skip);
   return result;
 }
 

@@ -88,7 +88,7 @@ enum class LoopStatus : int32_t {
   kFarInPrior = 5,          // The trajectory puts the two keyframes too far apart.
   kFewInliers = 6,          // Visual: too few 3D-2D matches agree on one relative pose.
   kDisagree = 7,            // Visual: the scan registration moved far from the image's pose.
-  kDuplicate = 8,           // Accepted, but an earlier detector closed the same query already.
+  kDuplicate = 8,  // Accepted, but an earlier detector closed the query (earlier versions).
 };
 const char* ToString(LoopStatus status);
 
@@ -133,7 +133,7 @@ class LoopScanCache;
 // scans of the verification (prepared with these options), shared with the visual detector.
 // skip(frame): queries not to verify (closed by a detector run before); the consistency - 1
 // keyframes before a query that is verified are verified too (its temporal consistency needs
-// them).
+// them), but only the other queries' candidates are returned.
 LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
                             const LidarLoopOptions& options, int threads,
                             const std::function<bool(int64_t)>& skip = nullptr,
@@ -145,8 +145,7 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
 // pass, then the normal one), and the LiDAR detector's bounds and temporal consistency decide.
 // It closes what a place descriptor cannot: a street driven the other way round on the other
 // lane. It relies on the trajectory's positions, so its recall falls with the drift where the
-// descriptors' does not. skip(frame): queries not to verify (closed by another detector); a
-// query that is verified has the consistency - 1 keyframes before it verified too.
+// descriptors' does not. skip(frame): as for DetectLidarLoops.
 LoopResult DetectProximityLoops(const Trajectory& keyframes, LoopScanCache& scans,
                                 const LidarLoopOptions& options, int threads,
                                 const std::function<bool(int64_t)>& skip = nullptr,
@@ -197,10 +196,11 @@ class LoopScanCache {
   LoopScanCache(std::function<PointCloud(int64_t)> load_scan, const Calibration& calibration,
                 const LidarLoopOptions& options, size_t capacity = 1024);
   std::shared_ptr<const LoopScan> Get(int64_t frame);
-  // Prepares the scans of `frames` (repeats allowed; at most `capacity` of them) on `threads`
+  // Prepares the scans of `frames` (repeats allowed; the first `capacity` distinct ones, so give
+  // them in the order they will be needed) on `threads`
   // threads before a verification needs them: each is prepared once, in parallel, instead of
   // two verifications waiting on the same scan.
-  void Prepare(std::vector<int64_t> frames, int threads);
+  void Prepare(const std::vector<int64_t>& frames, int threads);
   PointCloud Load(int64_t frame) const { return load_scan_(frame); }  // As read, not cached.
   const LidarLoopOptions& options() const { return options_; }        // The preparation's.
   const Calibration& calibration() const { return calibration_; }

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -183,10 +184,25 @@ TEST(ProximityLoops, ClosesTheStreetDrivenBackOnTheOtherLaneAndNothingElse) {
   // The way back within 50 m of the turn is not a revisit (min_separation_m along the path).
   EXPECT_GE(accepted, 12);
   EXPECT_GE(precise, accepted - 1);
-  // A query another detector closed is not verified, nor is the drive out (nothing before it).
+  // A query another detector closed is not returned (nor verified unless a later query's
+  // temporal consistency looks back to it); the open ones come out as without skipping.
   const LoopResult skipped =
       DetectProximityLoops(drifted, scans, o, 2, [](int64_t) { return true; });
   EXPECT_TRUE(skipped.candidates.empty());
+  auto closed = [](int64_t frame) { return (frame / 10) % 3 == 0; };
+  const LoopResult some = DetectProximityLoops(drifted, scans, o, 2, closed);
+  size_t open = 0;
+  for (const LoopCandidate& c : result.candidates) open += closed(c.query) ? 0 : 1;
+  ASSERT_EQ(some.candidates.size(), open);
+  for (const LoopCandidate& c : some.candidates) {
+    EXPECT_FALSE(closed(c.query));
+    const auto same = std::find_if(result.candidates.begin(), result.candidates.end(),
+                                   [&](const LoopCandidate& r) { return r.query == c.query; });
+    ASSERT_NE(same, result.candidates.end());
+    EXPECT_EQ(c.match, same->match);
+    EXPECT_EQ(c.status, same->status) << c.query;
+    EXPECT_EQ(c.match_from_query.translation(), same->match_from_query.translation());
+  }
   Trajectory out_only;
   for (size_t i = 0; i < out_count; ++i) out_only.Append(truth.frames[i], truth.world_from_cam[i]);
   EXPECT_TRUE(DetectProximityLoops(out_only, scans, o, 2).candidates.empty());

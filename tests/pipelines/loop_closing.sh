@@ -35,4 +35,16 @@ for run in visual:visual lidar:LiDAR proximity:proximity visual,lidar,proximity:
     echo "loop_closing: $label accepted $accepted loops, all right"
   fi
 done
+# The default run closes exactly the queries the detectors close alone: a later detector skips
+# only the queries closed already, and its open queries come out as when it runs alone.
+accepted_queries() { awk -F, 'NR > 1 && $4 == 0 { print $1 }' "$@" | sort -un; }
+union=$(accepted_queries "$out/loops_visual.csv" "$out/loops_LiDAR.csv" "$out/loops_proximity.csv")
+combined=$(accepted_queries "$out/loops_combined.csv")
+if [ "$union" != "$combined" ]; then
+  echo "loop_closing: the default run closed other queries than the detectors alone:" >&2
+  diff <(echo "$union") <(echo "$combined") >&2 || true
+  status=1
+else
+  echo "loop_closing: the default run closes the $(echo "$combined" | wc -l) queries the detectors close alone"
+fi
 exit $status

@@ -140,12 +140,13 @@ void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
 
 int main(int argc, char** argv) {
   app::Tool tool("loop_detect",
-                 "Loop closures of a drive: revisited places found with a LiDAR place descriptor "
-                 "(polar grid of largest heights, rotation-invariant ring key) and with visual "
-                 "words (bag of binary ORB words, ORB-SLAM2's candidate groups and temporal "
-                 "consistency); a LiDAR candidate is verified by registering the two scans, a "
-                 "visual one by PnP on the LiDAR depth of the earlier image and then the scan "
-                 "registration; every verified candidate, accepted or not, goes to the loops "
+                 "Loop closures of a drive: revisited places found with visual words (bag of "
+                 "binary ORB words, ORB-SLAM2's candidate groups and temporal consistency), with "
+                 "a LiDAR place descriptor (polar grid of largest heights, rotation-invariant "
+                 "ring key) and by proximity in the trajectory given (its nearest earlier "
+                 "keyframe); a visual candidate is verified by PnP on the LiDAR depth of the "
+                 "earlier image and then the scan registration, the others by registering the "
+                 "two scans; every verified candidate, accepted or not, goes to the loops "
                  "artifact.");
   std::string dataset_dir, frames = ":", poses_path, output, gt_path, csv, visual_path;
   int every = 5;
@@ -202,15 +203,16 @@ int main(int argc, char** argv) {
   cli.add_option("--gt", gt_path,
                  "Ground-truth trajectory: report the revisits and the loops' recall and "
                  "precision in the log");
+  app::OptionGroup shared(tool, "Every detector");
+  shared.Add("--min-separation", "min_separation_m", options.min_separation_m,
+             "Candidates lie at least this far back along the path (m)");
+  shared.Add("--max-residual", "max_residual", options.max_residual,
+             "Accept a registration with an RMS IMLS distance up to this (m)");
+  shared.Add("--min-correspondences", "min_correspondences", options.min_correspondences,
+             "Accept a registration with at least this many correspondences");
   app::OptionGroup lidar(tool, "LiDAR detector");
-  lidar.Add("--min-separation", "min_separation_m", options.min_separation_m,
-            "Candidates lie at least this far back along the path (m)");
   lidar.Add("--max-descriptor-distance", "max_descriptor_distance", options.max_descriptor_distance,
             "Verify the best candidate only below this descriptor distance (0 = identical, 1)");
-  lidar.Add("--max-residual", "max_residual", options.max_residual,
-            "Accept a registration with an RMS IMLS distance up to this (m)");
-  lidar.Add("--min-correspondences", "min_correspondences", options.min_correspondences,
-            "Accept a registration with at least this many correspondences");
   lidar.Add("--consistency", "consistency", options.consistency,
             "Accept a loop when this many consecutive keyframes have verified matches that agree");
   app::OptionGroup proximity(tool, "Proximity detector");
@@ -254,8 +256,8 @@ int main(int argc, char** argv) {
     const Trajectory keyframes = SelectKeyframes(poses, *dataset, every);
     JVL_CHECK(keyframes.size() >= 2,
               poses_path << ": fewer than 2 of its frames are in the dataset");
-    // One cache of prepared scans for both detectors: the visual one verifies mostly the pairs
-    // the LiDAR one prepared.
+    // One cache of prepared scans for every detector: the later ones verify pairs near those
+    // the earlier ones prepared.
     loop::LoopScanCache scans([&](int64_t f) { return dataset->LoadScan(f); },
                               dataset->calibration(), options, static_cast<size_t>(scan_cache));
     // The visual map's keypoints of a keyframe: rows [first, last) of keypoints/*.
