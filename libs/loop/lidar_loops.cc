@@ -89,7 +89,8 @@ lidar::ScanSurface PreparedSurface(const PointCloud& scan, const Calibration& ca
 LoopScan::LoopScan(const PointCloud& scan, const Calibration& calibration,
                    const LidarLoopOptions& o)
     : samples(lidar::SampleSurface(PreparedSurface(scan, calibration, o),
-                                   o.association.samples_per_list)) {}
+                                   o.association.samples_per_list)),
+      descriptor(ComputeScanDescriptor(scan.points, o.descriptor)) {}
 
 lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopScan& match,
                                             const Rigid3d& initial, const LidarLoopOptions& o) {
@@ -163,6 +164,18 @@ std::shared_ptr<const LoopScan> LoopScanCache::Get(int64_t frame) {
   const std::lock_guard<std::mutex> lock(slot->mutex);
   if (!slot->scan)
     slot->scan = std::make_shared<const LoopScan>(load_scan_(frame), calibration_, options_);
+  return slot->scan;
+}
+
+std::shared_ptr<const LoopScan> LoopScanCache::Find(int64_t frame) {
+  std::shared_ptr<Slot> slot;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = slots_.find(frame);
+    if (it == slots_.end()) return nullptr;
+    slot = it->second.first;
+  }
+  const std::lock_guard<std::mutex> lock(slot->mutex);
   return slot->scan;
 }
 
@@ -307,8 +320,17 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
   result.keyframes = keyframes.frames;
   const std::vector<double> path = PathLengths(keyframes);
   std::vector<ScanDescriptor> descriptors(n);
+  const ScanDescriptorOptions& d = scans.options().descriptor;
+  const bool same_descriptor = d.rings == o.descriptor.rings && d.sectors == o.descriptor.sectors &&
+                               d.max_range == o.descriptor.max_range &&
+                               d.sensor_height == o.descriptor.sensor_height;
   ParallelFor(static_cast<int64_t>(n), threads, [&](int64_t i) {
-    descriptors[i] = ComputeScanDescriptor(scans.Load(keyframes.frames[i]).points, o.descriptor);
+    // From the prepared scan where a detector before prepared it (the same descriptor).
+    const std::shared_ptr<const LoopScan> prepared =
+        same_descriptor ? scans.Find(keyframes.frames[i]) : nullptr;
+    descriptors[i] =
+        prepared ? prepared->descriptor
+                 : ComputeScanDescriptor(scans.Load(keyframes.frames[i]).points, o.descriptor);
     if (tick) tick();
   });
 

@@ -157,6 +157,9 @@ LoopResult DetectProximityLoops(const Trajectory& keyframes, LoopScanCache& scan
 struct LoopScan {
   LoopScan(const PointCloud& scan, const Calibration& calibration, const LidarLoopOptions& options);
   lidar::SampledScan samples;
+  // The place descriptor of the scan as read (a few kB: made with the preparation, so that the
+  // LiDAR detector does not read a prepared scan again).
+  ScanDescriptor descriptor;
 };
 // ... `query` registered on `match` from `initial` = match_from_query: a coarse pass with
 // scaled neighbourhoods, then the normal one (as lidar_odom's first pair) ...
@@ -196,6 +199,8 @@ class LoopScanCache {
   LoopScanCache(std::function<PointCloud(int64_t)> load_scan, const Calibration& calibration,
                 const LidarLoopOptions& options, size_t capacity = 1024);
   std::shared_ptr<const LoopScan> Get(int64_t frame);
+  // The scan of `frame` if it is prepared and kept, else null (nothing is prepared).
+  std::shared_ptr<const LoopScan> Find(int64_t frame);
   // Prepares the scans of `frames` (repeats allowed; the first `capacity` distinct ones, so give
   // them in the order they will be needed) on `threads`
   // threads before a verification needs them: each is prepared once, in parallel, instead of
