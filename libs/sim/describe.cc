@@ -168,6 +168,16 @@ nlohmann::json DescribeScene(const World& world) {
                 {"dropout", l.dropout},
                 {"motion_distortion", l.motion_distortion},
                 {"height_m", world.options.lidar_height}};
+  // Written only when set, so that scene.json of the default sensors stays as it was.
+  if (l.elevation_bias_deg != 0) j["lidar"]["elevation_bias_deg"] = l.elevation_bias_deg;
+  if (world.options.calib_error_deg != 0 || world.options.calib_error_m != 0) {
+    const Rigid3d error = WrittenCalibrationError(world.options);
+    j["calibration_error"] = {
+        {"rotation_deg", world.options.calib_error_deg},
+        {"translation_m", world.options.calib_error_m},
+        {"written_cam0_from_true_cam0", Matrix4(error)},
+        {"true_cam0_from_velo", Matrix4(world.options.calibration.cam0_from_velo)}};
+  }
   j["mesh"] = {{"triangles", sc.mesh.triangles.size()}, {"faces", sc.mesh.faces.size()}};
   return j;
 }

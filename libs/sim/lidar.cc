@@ -13,12 +13,18 @@ constexpr double kPi = 3.14159265358979323846;
 
 void LidarOptions::Check() const {
   JVL_CHECK(beams >= 2 && beams <= 256, "beams must be in [2, 256], got " << beams);
-  JVL_CHECK(elevation_max_deg > elevation_min_deg, "elevation_max_deg must exceed elevation_min_deg");
+  JVL_CHECK(elevation_max_deg > elevation_min_deg,
+            "elevation_max_deg must exceed elevation_min_deg");
   JVL_CHECK(azimuth_steps >= 16, "azimuth_steps must be >= 16, got " << azimuth_steps);
-  JVL_CHECK(max_range > min_range && min_range >= 0, "min_range must be >= 0 and below max_range, got " << min_range << " and " << max_range);
+  JVL_CHECK(
+      max_range > min_range && min_range >= 0,
+      "min_range must be >= 0 and below max_range, got " << min_range << " and " << max_range);
   JVL_CHECK(range_noise >= 0, "range_noise must be >= 0, got " << range_noise);
+  JVL_CHECK(std::isfinite(elevation_bias_deg) && std::abs(elevation_bias_deg) <= 2,
+            "elevation_bias_deg must be in [-2, 2] deg, got " << elevation_bias_deg);
   JVL_CHECK(dropout >= 0 && dropout < 1, "dropout must be in [0, 1), got " << dropout);
-  JVL_CHECK(glass_dropout >= 0 && glass_dropout <= 1, "glass_dropout must be in [0, 1], got " << glass_dropout);
+  JVL_CHECK(glass_dropout >= 0 && glass_dropout <= 1,
+            "glass_dropout must be in [0, 1], got " << glass_dropout);
   JVL_CHECK(sweep_period > 0, "sweep_period must be > 0, got " << sweep_period);
 }
 
@@ -44,8 +50,12 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
                         const SweepPose* sweep_pose) {
   const std::vector<double> elev = options.ElevationsRad();
   const int nb = static_cast<int>(elev.size()), na = options.azimuth_steps;
-  std::vector<double> ce(nb), se(nb);
-  for (int b = 0; b < nb; ++b) ce[b] = std::cos(elev[b]), se[b] = std::sin(elev[b]);
+  std::vector<double> ce(nb), se(nb), ce_reported(nb), se_reported(nb);
+  const double bias = options.elevation_bias_deg * kPi / 180.0;
+  for (int b = 0; b < nb; ++b) {
+    ce[b] = std::cos(elev[b]), se[b] = std::sin(elev[b]);
+    ce_reported[b] = std::cos(elev[b] - bias), se_reported[b] = std::sin(elev[b] - bias);
+  }
   // Per slot: point in the frame-time velodyne frame, intensity, and validity.
   std::vector<Eigen::Vector3f> pts(static_cast<size_t>(nb) * na);
   std::vector<float> inten(pts.size());
@@ -78,7 +88,9 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
       const size_t k = static_cast<size_t>(b) * na + a;
       // The sensor reports the return in its own frame at firing time: with motion distortion
       // the scan is not compensated for the motion during the sweep (as raw KITTI scans).
-      pts[k] = (r * d_velo).cast<float>();
+      // (Along the beam as the sensor reports it: lower by the elevation bias, if any.)
+      const Eigen::Vector3d d_reported(ce_reported[b] * ca, ce_reported[b] * sa, se_reported[b]);
+      pts[k] = (r * d_reported).cast<float>();
       const double incidence = std::abs(hit.normal.dot(d));
       inten[k] = static_cast<float>(
           std::clamp(surf.reflectance * (0.45 + 0.55 * incidence) + 0.02 * n_int, 0.0, 0.99));

@@ -5,6 +5,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lidar/preprocess.h"
 #include "sim/raycaster.h"
 #include "sim/road.h"
 #include "sim/scene.h"
@@ -331,6 +332,66 @@ TEST(LidarTest, MotionDistortionShiftsColumnsByTheMotion) {
       if (std::abs(p.x() - expected) > 2e-3) break;
     }
   }
+}
+
+// With an elevation bias every return keeps its range and azimuth and lies that much lower,
+// and lidar_odom's vertical correction (lidar::CorrectVerticalAngle) by the same angle gives the
+// unbiased scan back.
+TEST(LidarTest, ElevationBiasLowersEveryReturnAndTheCorrectionUndoesIt) {
+  Scene scene;
+  AddBox(scene.mesh, Eigen::Vector2d(20.5, 0), 0.0, 1.0, 100.0, -50, 50, 0, Material::kFacade,
+         Material::kRoof, -1, 0.5f);
+  for (auto& f : scene.mesh.faces) f.material = Material::kPole;
+  const RayCaster caster(scene.mesh);
+  LidarOptions opt;
+  opt.dropout = 0;
+  const PointCloud plain = SimulateScan(scene, caster, Rigid3d(), {}, opt, 3);
+  opt.elevation_bias_deg = 0.22;
+  const PointCloud biased = SimulateScan(scene, caster, Rigid3d(), {}, opt, 3);
+  ASSERT_GT(plain.size(), 1000u);
+  ASSERT_EQ(plain.size(), biased.size());
+  std::vector<Eigen::Vector3d> corrected = biased.points;
+  lidar::CorrectVerticalAngle(0.22 * M_PI / 180, &corrected);
+  auto elevation = [](const Eigen::Vector3d& p) { return std::atan2(p.z(), p.head<2>().norm()); };
+  double worst = 0;
+  for (size_t i = 0; i < plain.size(); ++i) {
+    const Eigen::Vector3d &u = plain.points[i], &b = biased.points[i];
+    EXPECT_NEAR(b.norm(), u.norm(), 1e-4);
+    EXPECT_NEAR(std::atan2(b.y(), b.x()), std::atan2(u.y(), u.x()), 1e-6);
+    EXPECT_NEAR((elevation(u) - elevation(b)) * 180 / M_PI, 0.22, 1e-4);
+    worst = std::max(worst, (corrected[i] - u).norm());
+  }
+  EXPECT_LT(worst, 1e-4);
+  opt.elevation_bias_deg = 3;
+  EXPECT_THROW(opt.Check(), std::exception);
+}
+
+// The calibration written is the rig's moved by the error asked for: that angle and distance,
+// along directions drawn from the seed; none without an error.
+TEST(SequenceTest, CalibrationErrorIsWrittenAsAsked) {
+  SequenceOptions opt;
+  const Rigid3d none = WrittenCalibrationError(opt);
+  EXPECT_EQ(none.translation().norm(), 0);
+  EXPECT_EQ(RotationAngle(none.rotation()), 0);
+  opt.calib_error_deg = 0.5;
+  opt.calib_error_m = 0.05;
+  opt.seed = 7;
+  const Rigid3d error = WrittenCalibrationError(opt);
+  EXPECT_NEAR(RotationAngle(error.rotation()) * 180 / M_PI, 0.5, 1e-9);
+  EXPECT_NEAR(error.translation().norm(), 0.05, 1e-12);
+  const Calibration written = WrittenCalibration(opt);
+  const Rigid3d expected = error * opt.calibration.cam0_from_velo;
+  EXPECT_LT((written.cam0_from_velo.translation() - expected.translation()).norm(), 1e-12);
+  EXPECT_LT(RotationAngle(written.cam0_from_velo.rotation().inverse() * expected.rotation()),
+            1e-12);
+  EXPECT_EQ(written.Camera(0).fx, opt.calibration.Camera(0).fx);  // Intrinsics untouched.
+  // Deterministic per seed, another seed another direction.
+  const Rigid3d again = WrittenCalibrationError(opt);
+  EXPECT_EQ(again.translation(), error.translation());
+  opt.seed = 8;
+  EXPECT_GT((WrittenCalibrationError(opt).translation() - error.translation()).norm(), 1e-3);
+  opt.calib_error_deg = -1;
+  EXPECT_THROW(opt.Check(), std::exception);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "sim/sequence.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/check.h"
@@ -43,6 +44,10 @@ void SequenceOptions::Check() const {
             "calibration has no image size");
   JVL_CHECK(std::isfinite(road_beyond) && road_beyond >= 0 && road_beyond <= 1000,
             "road_beyond must be in [0, 1000] m, got " << road_beyond);
+  JVL_CHECK(std::isfinite(calib_error_deg) && calib_error_deg >= 0 && calib_error_deg <= 10,
+            "calib_error_deg must be in [0, 10] deg, got " << calib_error_deg);
+  JVL_CHECK(std::isfinite(calib_error_m) && calib_error_m >= 0 && calib_error_m <= 1,
+            "calib_error_m must be in [0, 1] m, got " << calib_error_m);
   drive.Check();
   scene.Check();
   lidar.Check();
@@ -54,6 +59,28 @@ void SequenceOptions::Check() const {
       JVL_CHECK(cameras[i] != cameras[j], "camera " << cameras[i] << " is listed twice");
     calibration.CheckCamera(cameras[i], "the calibration");
   }
+}
+
+Rigid3d WrittenCalibrationError(const SequenceOptions& options) {
+  if (options.calib_error_deg == 0 && options.calib_error_m == 0) return Rigid3d();
+  // Its own stream of the seed: the world and the noise do not change with the error.
+  Rng rng(options.seed ^ 0xca11b0a7e5ULL);
+  auto unit = [&rng] {
+    // Uniform on the sphere.
+    const double z = rng.Uniform(-1, 1), phi = rng.Uniform(0, 2 * 3.14159265358979323846);
+    const double r = std::sqrt(std::max(0.0, 1 - z * z));
+    return Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z);
+  };
+  const Eigen::Vector3d axis = unit(), direction = unit();
+  return Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(
+                     options.calib_error_deg * 3.14159265358979323846 / 180, axis)),
+                 options.calib_error_m * direction);
+}
+
+Calibration WrittenCalibration(const SequenceOptions& options) {
+  Calibration written = options.calibration;
+  written.cam0_from_velo = WrittenCalibrationError(options) * options.calibration.cam0_from_velo;
+  return written;
 }
 
 Rigid3d World::MapFromVeloAt(double t) const {

@@ -38,6 +38,11 @@ struct SequenceOptions {
   double road_beyond = 120.0;
   double lidar_height = 1.73;  // Velodyne above the road (KITTI setup).
   Calibration calibration = KittiCalibration();
+  // Calibration error: the calib.txt written holds the camera-LiDAR extrinsic (Tr) off the rig
+  // the data were made with by a rotation of calib_error_deg about an axis and a translation of
+  // calib_error_m along a direction, both drawn from the seed (0, 0: the true rig).
+  double calib_error_deg = 0.0;
+  double calib_error_m = 0.0;
   DriveOptions drive;
   SceneOptions scene;
   LidarOptions lidar;
@@ -62,6 +67,12 @@ struct World {
 };
 
 std::unique_ptr<World> BuildWorld(const SequenceOptions& options);
+
+// The calibration written with the sequence: options.calibration with its cam0_from_velo moved
+// by the calibration error (WrittenCalibrationError x cam0_from_velo).
+Calibration WrittenCalibration(const SequenceOptions& options);
+// The calibration error as written cam0 from true cam0 (identity without one).
+Rigid3d WrittenCalibrationError(const SequenceOptions& options);
 
 struct SimFrame {
   int64_t frame = 0;

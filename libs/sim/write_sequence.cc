@@ -15,7 +15,8 @@ WriteStats WriteSequence(const World& world, const io::SequenceLayout& layout_in
   const SequenceOptions& opt = world.options;
   io::SequenceLayout layout = layout_in;
   layout.times = world.ground_truth.timestamps;
-  io::WriteSequenceMetadata(layout, opt.calibration, world.ground_truth);
+  // The calibration as written (with the calibration error, if any); the data come from the rig.
+  io::WriteSequenceMetadata(layout, WrittenCalibration(opt), world.ground_truth);
   std::vector<std::vector<io::GtVpRow>> vps(world.ground_truth.size());
   std::atomic<int64_t> points{0};
   Timer timer;

@@ -27,6 +27,14 @@ void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
   sensors.Add("--dropout", "dropout", o->lidar.dropout, "LiDAR random dropout probability");
   sensors.Flag("--motion-distortion", o->lidar.motion_distortion,
                "Move the LiDAR during the 0.1 s sweep");
+  sensors.Add("--lidar-elevation-bias", "elevation_bias_deg", o->lidar.elevation_bias_deg,
+              "Report every LiDAR return this much (deg) below its beam, as the KITTI HDL-64E "
+              "scans do by about 0.2 (lidar_odom --vertical-correction undoes it); 0: none");
+  sensors.Add("--calib-error-deg", "calib_error_deg", o->calib_error_deg,
+              "Write calib.txt's camera-LiDAR extrinsic (Tr) rotated this much (deg) off the "
+              "rig the data come from, about an axis drawn from the seed; 0: the true rig");
+  sensors.Add("--calib-error-m", "calib_error_m", o->calib_error_m,
+              "... and moved this far (m) along a direction drawn from the seed");
   sensors.Add("--pixel-noise", o->camera.pixel_noise, "Image noise sigma (grey levels)");
   sensors
       .Add("--supersample", o->camera.supersample,
