@@ -611,6 +611,10 @@ TEST_F(BadInputTest, InvalidOptions) {
               "--sequence must be two digits");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --frames 100000", "--frames 100000 exceeds");
   ExpectError("sim_sequence", "-o " + Bad("sim") + " --scenario mars", "mars");
+  ExpectError("sim_sequence", "-o " + Bad("sim") + " --calib-error-deg -1",
+              "--calib-error-deg must be in [0, 10] deg");
+  ExpectError("sim_sequence", "-o " + Bad("sim") + " --lidar-elevation-bias 5",
+              "--lidar-elevation-bias must be in [-2, 2] deg");
   ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + Bad("x.h5") + " --preset bogus",
               "unknown prior preset 'bogus'");
   ExpectError("make_prior", "-g " + In("prior.h5") + " -o " + Bad("x.h5") + " --yaw-drift nan",
