@@ -199,6 +199,16 @@ LoopStatus RegistrationStatus(const lidar::RegistrationResult& reg, const LidarL
   return LoopStatus::kAccepted;
 }
 
+void TakeRegistration(const lidar::RegistrationResult& reg, const LidarLoopOptions& o,
+                      LoopCandidate* c) {
+  c->match_from_query = reg.world_from_scan;
+  c->correspondences = reg.correspondences;
+  c->residual = reg.residual;
+  c->converged = reg.converged;
+  c->degenerate = reg.degenerate;
+  c->status = RegistrationStatus(reg, o);
+}
+
 double RelativeHeading(const Rigid3d& match_from_query) {
   const Eigen::Vector3d forward = match_from_query.rotation() * Eigen::Vector3d::UnitZ();
   return std::atan2(-forward.x(), forward.z());
@@ -414,7 +424,6 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
         Eigen::Vector3d::Zero());
     return cam0_from_velo * velo_match_from_query * cam0_from_velo.Inverse();
   };
-  auto status_of = [&](const lidar::RegistrationResult& reg) { return RegistrationStatus(reg, o); };
   // One candidate, registered from its best yaw and from the opposite one.
   auto VerifyPick = [&](const Pick& pick, size_t q, const LoopScan& query_scan) {
     LoopCandidate c;
@@ -430,17 +439,10 @@ LoopResult DetectLidarLoops(const Trajectory& keyframes, LoopScanCache& scans,
     const lidar::RegistrationResult reg =
         RegisterLoopScans(query_scan, *match_scan,
                           {initial_for(pick.m.yaw), initial_for(pick.opposite.yaw)}, o, &which);
-    LoopStatus status = status_of(reg);
-    const double yaw = which == 0 ? pick.m.yaw : pick.opposite.yaw;
-    c.yaw_rad = yaw;
-    c.match_from_query = reg.world_from_scan;
-    c.correspondences = reg.correspondences;
-    c.residual = reg.residual;
-    c.converged = reg.converged;
-    c.degenerate = reg.degenerate;
-    if (status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, pick.match, o))
-      status = LoopStatus::kFarInPrior;
-    c.status = status;
+    c.yaw_rad = which == 0 ? pick.m.yaw : pick.opposite.yaw;
+    TakeRegistration(reg, o, &c);
+    if (c.status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, pick.match, o))
+      c.status = LoopStatus::kFarInPrior;
     return c;
   };
   ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t v) {
@@ -509,14 +511,9 @@ LoopResult DetectProximityLoops(const Trajectory& keyframes, LoopScanCache& scan
     c.yaw_rad = RelativeHeading(initial);
     const lidar::RegistrationResult reg =
         RegisterLoopScans(*scans.Get(c.query), *scans.Get(c.match), initial, o);
-    c.status = RegistrationStatus(reg, o);
+    TakeRegistration(reg, o, &c);
     if (c.status == LoopStatus::kAccepted && FarInPrior(keyframes, path, q, m, o))
       c.status = LoopStatus::kFarInPrior;
-    c.match_from_query = reg.world_from_scan;
-    c.correspondences = reg.correspondences;
-    c.residual = reg.residual;
-    c.converged = reg.converged;
-    c.degenerate = reg.degenerate;
     verified[static_cast<size_t>(v)] = c;
     if (tick) tick();
   });

@@ -176,6 +176,10 @@ lidar::RegistrationResult RegisterLoopScans(const LoopScan& query, const LoopSca
 // ... and its status against the bounds (accepted, registration failed, residual, too far).
 LoopStatus RegistrationStatus(const lidar::RegistrationResult& registration,
                               const LidarLoopOptions& options);
+// The registration into a candidate: its pose (match_from_query), correspondences, residual,
+// convergence and degeneracy, and the status RegistrationStatus gives it.
+void TakeRegistration(const lidar::RegistrationResult& registration,
+                      const LidarLoopOptions& options, LoopCandidate* candidate);
 // Heading of the query relative to the match (about the camera's vertical, left positive; rad).
 double RelativeHeading(const Rigid3d& match_from_query);
 // Two loops of consecutive queries against each other: loop2 (match_from_query of query2) as

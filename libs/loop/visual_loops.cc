@@ -200,12 +200,8 @@ void RegisterVisualCandidate(const Rigid3d& image_pose, int64_t query_frame, int
   const CameraChoice choice = CameraChoice::Of(calibration, o.camera);
   const lidar::RegistrationResult reg =
       RegisterLoopScans(*scans.Get(query_frame), *scans.Get(match_frame), image_pose, o.lidar);
-  c.match_from_query = reg.ok ? reg.world_from_scan : image_pose;
-  c.correspondences = reg.correspondences;
-  c.residual = reg.residual;
-  c.converged = reg.converged;
-  c.degenerate = reg.degenerate;
-  c.status = RegistrationStatus(reg, o.lidar);
+  TakeRegistration(reg, o.lidar, &c);
+  if (!reg.ok) c.match_from_query = image_pose;  // No registered pose: the image's.
   const Rigid3d moved = image_pose.Inverse() * c.match_from_query;
   if (c.status == LoopStatus::kAccepted &&
       (moved.translation().norm() > o.max_disagreement_m ||

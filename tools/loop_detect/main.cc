@@ -54,9 +54,9 @@ Trajectory SelectKeyframes(const Trajectory& poses, const io::Dataset& dataset, 
 // min_separation back along the true path lies within 5 m (same direction: headings within
 // 30 deg; opposite: more than 150 deg apart). A loop is right when its relative pose is within
 // 1 m and 2 deg of the true one.
-// detector: -1 = every accepted loop; 0 / 1 / 2 = the loops that detector accepted (a loop
-// marked duplicate counts for its detector). A detector run after another verified only the
-// queries left open: run it alone (--detectors) for its own recall.
+// detector: -1 = every accepted loop; 0 / 1 / 2 = the loops that detector accepted. A detector
+// run after another verified only the queries left open: run it alone (--detectors) for its own
+// recall.
 void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
                               double min_separation, int detector, const std::string& label) {
   Trajectory kf;
@@ -84,11 +84,8 @@ void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
   }
   std::vector<int> found(n, 0);
   int accepted = 0, right = 0;
-  constexpr int32_t kDuplicate = static_cast<int32_t>(loop::LoopStatus::kDuplicate);
   for (const io::LoopRecord& r : loops.loops) {
-    if (detector < 0 ? r.status != 0
-                     : (r.detector != detector || (r.status != 0 && r.status != kDuplicate)))
-      continue;
+    if (r.status != 0 || (detector >= 0 && r.detector != detector)) continue;
     ++accepted;
     const auto q = gt.IndexOf(r.query), m = gt.IndexOf(r.match);
     const Rigid3d truth = gt.world_from_cam[*m].Inverse() * gt.world_from_cam[*q];
@@ -180,9 +177,7 @@ int main(int argc, char** argv) {
   cli.add_option("--detectors", detectors,
                  "Detectors to run (any of visual, lidar, proximity; run in that order, each "
                  "later one verifying only the queries the ones before it left open). proximity: "
-                 "the trajectory's nearest earlier keyframe, verified by scan registration. A "
-                 "loop whose query an earlier detector closed too is kept with status 8, "
-                 "duplicate")
+                 "the trajectory's nearest earlier keyframe, verified by scan registration")
       ->delimiter(',')
       ->check(CLI::IsMember({"lidar", "visual", "proximity"}))
       ->capture_default_str();
@@ -292,24 +287,17 @@ int main(int argc, char** argv) {
     if (use_visual) dataset->CheckCamera(visual_options.camera);
     // The detectors in turn: visual, LiDAR, proximity. A later one verifies only the queries
     // the ones before it left open (and the keyframes before them that its temporal
-    // consistency needs); its loop on a query closed already is kept as a duplicate.
+    // consistency needs) and returns only theirs, so a query gets at most one loop.
     std::vector<loop::LoopCandidate> candidates;
     std::vector<int64_t> closed;  // Queries a detector accepted, sorted.
     auto is_closed = [&](int64_t query) {
       return std::binary_search(closed.begin(), closed.end(), query);
     };
     auto take = [&](const loop::LoopResult& result) {
-      std::vector<int64_t> closed_now;
-      for (loop::LoopCandidate c : result.candidates) {
-        if (c.status == loop::LoopStatus::kAccepted) {
-          if (is_closed(c.query))
-            c.status = loop::LoopStatus::kDuplicate;
-          else
-            closed_now.push_back(c.query);
-        }
+      for (const loop::LoopCandidate& c : result.candidates) {
         candidates.push_back(c);
+        if (c.status == loop::LoopStatus::kAccepted) closed.push_back(c.query);
       }
-      closed.insert(closed.end(), closed_now.begin(), closed_now.end());
       std::sort(closed.begin(), closed.end());
     };
     if (use_visual) {
@@ -365,7 +353,7 @@ int main(int argc, char** argv) {
       r.yaw_deg = c.yaw_rad * kRadToDeg;
       r.correspondences = c.correspondences;
       r.inliers = c.inliers;
-      if (c.status == loop::LoopStatus::kAccepted || c.status == loop::LoopStatus::kDuplicate) {
+      if (c.status == loop::LoopStatus::kAccepted) {
         for (const loop::LoopPoint& p : c.points)
           r.points.push_back({p.p_match, p.match_uv, p.query_uv, p.match_octave, p.query_octave});
       }
