@@ -21,7 +21,11 @@ void ImlsModel::AddScan(int64_t scan_id, const std::vector<Eigen::Vector3d>& wor
   for (size_t i = 0; i < world_points.size(); ++i) {
     const Eigen::Vector3i c = CellOf(world_points[i], inv_cell_);
     const uint64_t key = PackCell(c.x(), c.y(), c.z());
-    std::vector<Entry>& cell = cells_[key];
+    const size_t index = static_cast<size_t>(index_.Insert(key, static_cast<int>(cells_.size())));
+    const bool fresh = index == cells_.size();
+    if (fresh) cells_.emplace_back();
+    std::vector<Entry>& cell = cells_[index];
+    if (cell.empty() && !fresh) --empty_cells_;  // A cell emptied by RemoveScan, filled again.
     if (cell.empty() || cell.back().scan != scan_id) touched.push_back(key);
     cell.push_back({world_points[i].cast<float>(), world_normals[i].cast<float>(), scan_id});
   }
@@ -36,20 +40,46 @@ void ImlsModel::RemoveScan(int64_t scan_id) {
       std::find_if(scans_.begin(), scans_.end(), [&](const auto& s) { return s.first == scan_id; });
   if (it == scans_.end()) return;
   for (const uint64_t key : it->second) {
-    const auto cell = cells_.find(key);
-    if (cell == cells_.end()) continue;
-    std::vector<Entry>& v = cell->second;
+    const int index = index_.Find(key);
+    if (index < 0) continue;
+    std::vector<Entry>& v = cells_[static_cast<size_t>(index)];
     const size_t before = v.size();
     v.erase(std::remove_if(v.begin(), v.end(), [&](const Entry& e) { return e.scan == scan_id; }),
             v.end());
     num_points_ -= before - v.size();
-    if (v.empty()) cells_.erase(cell);
+    if (before > 0 && v.empty()) {
+      std::vector<Entry>().swap(v);
+      ++empty_cells_;
+    }
   }
   scans_.erase(it);
+  CompactIfSparse();
+}
+
+void ImlsModel::CompactIfSparse() {
+  if (empty_cells_ < 4096 || 2 * empty_cells_ < cells_.size()) return;
+  // The non-empty cells again, in their order (a cell's entries keep theirs, so every query
+  // sums in the same order as before).
+  std::vector<std::vector<Entry>> kept;
+  kept.reserve(cells_.size() - empty_cells_);
+  CellMap index(cells_.size() - empty_cells_);
+  for (const auto& [id, keys] : scans_) {
+    for (const uint64_t key : keys) {
+      std::vector<Entry>& v = cells_[static_cast<size_t>(index_.Find(key))];
+      if (v.empty()) continue;  // Moved already (a cell shared by several scans).
+      index.Insert(key, static_cast<int>(kept.size()));
+      kept.push_back(std::move(v));
+    }
+  }
+  cells_ = std::move(kept);
+  index_ = std::move(index);
+  empty_cells_ = 0;
 }
 
 void ImlsModel::Clear() {
+  index_ = CellMap();
   cells_.clear();
+  empty_cells_ = 0;
   scans_.clear();
   num_points_ = 0;
 }
@@ -71,9 +101,9 @@ bool ImlsModel::HasNeighbor(const Eigen::Vector3d& x, double radius) const {
   for (int dx = -span; dx <= span; ++dx) {
     for (int dy = -span; dy <= span; ++dy) {
       for (int dz = -span; dz <= span; ++dz) {
-        const auto it = cells_.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
-        if (it == cells_.end()) continue;
-        for (const Entry& e : it->second) {
+        const std::vector<Entry>* cell = Cell(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
+        if (cell == nullptr) continue;
+        for (const Entry& e : *cell) {
           if ((e.point.cast<double>() - x).squaredNorm() <= r2) return true;
         }
       }
@@ -98,9 +128,9 @@ bool ImlsModel::Project(const Eigen::Vector3d& x, double h, double radius,
   for (int dx = -span; dx <= span; ++dx) {
     for (int dy = -span; dy <= span; ++dy) {
       for (int dz = -span; dz <= span; ++dz) {
-        const auto it = cells_.find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
-        if (it == cells_.end()) continue;
-        for (const Entry& e : it->second) {
+        const std::vector<Entry>* cell = Cell(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
+        if (cell == nullptr) continue;
+        for (const Entry& e : *cell) {
           const Eigen::Vector3d d = x - e.point.cast<double>();
           const double d2 = d.squaredNorm();
           if (d2 > r2) continue;

@@ -60,9 +60,20 @@ class ImlsModel {
     Eigen::Vector3f point, normal;
     int64_t scan;
   };
+  // The entries of a cell (nullptr when the model has none).
+  const std::vector<Entry>* Cell(uint64_t key) const {
+    const int index = index_.Find(key);
+    return index < 0 ? nullptr : &cells_[static_cast<size_t>(index)];
+  }
+  // Drops the cells left empty by RemoveScan from the index once they outnumber the others.
+  void CompactIfSparse();
   double cell_size_, inv_cell_;
   size_t num_points_ = 0;
-  std::unordered_map<uint64_t, std::vector<Entry>, CellHash> cells_;
+  // Cell key -> index into cells_ (open addressing: the 27 lookups of a query cost less than
+  // the points they find). RemoveScan leaves emptied cells in place until CompactIfSparse.
+  CellMap index_;
+  std::vector<std::vector<Entry>> cells_;
+  size_t empty_cells_ = 0;
   std::deque<std::pair<int64_t, std::vector<uint64_t>>> scans_;  // id, cells it touched.
 };
 

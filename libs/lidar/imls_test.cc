@@ -76,6 +76,58 @@ TEST(ImlsTest, ScansAddedAndRemoved) {
   EXPECT_FALSE(model.HasNeighbor(Eigen::Vector3d::Zero(), 1.0));
 }
 
+// A sliding window of scans moving along a street (as lidar_odom's map): after thousands of
+// cells were emptied and dropped from the index, the model answers exactly as one built from the
+// scans still in it, and an emptied cell filled again is found.
+TEST(ImlsTest, SlidingWindowAnswersAsAFreshModel) {
+  auto scan = [](int s) {
+    std::vector<Eigen::Vector3d> pts, normals;
+    for (int i = 0; i < 400; ++i) {
+      const double x = 2.0 * s + 0.05 * i, y = 0.3 * std::sin(0.7 * i + s);
+      pts.emplace_back(x, y, 0.01 * (i % 7));
+      normals.push_back(Eigen::Vector3d(0.1 * std::cos(i), 0, 1).normalized());
+      pts.emplace_back(x, 4.0, 0.2 * (i % 11));
+      normals.emplace_back(0, -1, 0);
+    }
+    return std::make_pair(pts, normals);
+  };
+  ImlsModel window(0.3);
+  const int kWindow = 5, kScans = 120;
+  for (int s = 0; s < kScans; ++s) {
+    const auto [pts, normals] = scan(s);
+    window.AddScan(s, pts, normals);
+    if (s >= kWindow) window.RemoveScan(s - kWindow);
+  }
+  // The street driven back: the cells of scan 3, emptied long ago, filled again.
+  const auto [back_pts, back_normals] = scan(3);
+  window.AddScan(1000, back_pts, back_normals);
+  ImlsModel fresh(0.3);
+  for (const int64_t id : window.scan_ids()) {
+    const auto [pts, normals] = scan(id == 1000 ? 3 : static_cast<int>(id));
+    fresh.AddScan(id, pts, normals);
+  }
+  ASSERT_EQ(window.size(), fresh.size());
+  int found = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d x(0.08 * i, 0.37 * std::sin(0.3 * i) + (i % 3 == 0 ? 4 : 0),
+                            0.05 * (i % 9));
+    ImlsProjection a, b;
+    const bool ha = window.Project(x, 0.15, 0.3, &a), hb = fresh.Project(x, 0.15, 0.3, &b);
+    ASSERT_EQ(ha, hb) << i;
+    ASSERT_EQ(window.HasNeighbor(x, 0.3), fresh.HasNeighbor(x, 0.3)) << i;
+    if (!ha) continue;
+    ++found;
+    EXPECT_EQ(a.distance, b.distance) << i;  // The same sums in the same order.
+    EXPECT_EQ(a.nearest_scan, b.nearest_scan) << i;
+    EXPECT_EQ(a.neighbors, b.neighbors) << i;
+  }
+  EXPECT_GT(found, 100);
+  ImlsProjection p;
+  EXPECT_TRUE(window.Project(back_pts[10], 0.15, 0.3, &p));
+  EXPECT_EQ(p.nearest_scan, 1000);
+  EXPECT_FALSE(window.Project(scan(50).first[10], 0.15, 0.3, &p));  // Removed long ago.
+}
+
 TEST(SurfaceTest, NormalsAndPlanarityOfAPlaneAndALine) {
   std::vector<Eigen::Vector3d> pts;
   for (double x = -3; x <= 3; x += 0.25) {

@@ -6,9 +6,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <optional>
+#include <unordered_map>
 
 #include "core/check.h"
 #include "core/threads.h"
@@ -109,6 +112,61 @@ cv::Mat ScanDepth(const PointCloud& scan, const Calibration& calibration,
   return depth;
 }
 
+// The non-zero pixels of ScanDepth's image (row-major index, depth): a match keyframe's depth
+// is kept in this form between candidates (a few hundred kB where the scan is read and
+// projected again in milliseconds), and the image rebuilt from it is the same.
+using SparseDepth = std::vector<std::pair<int32_t, float>>;
+
+SparseDepth ToSparse(const cv::Mat& depth) {
+  SparseDepth sparse;
+  for (int v = 0; v < depth.rows; ++v) {
+    const float* row = depth.ptr<float>(v);
+    for (int u = 0; u < depth.cols; ++u)
+      if (row[u] > 0) sparse.emplace_back(v * depth.cols + u, row[u]);
+  }
+  return sparse;
+}
+
+cv::Mat FromSparse(const SparseDepth& sparse, int rows, int cols) {
+  cv::Mat depth(rows, cols, CV_32F, cv::Scalar(0));
+  float* data = depth.ptr<float>(0);
+  for (const auto& [index, z] : sparse) data[index] = z;
+  return depth;
+}
+
+// The depth of the latest match keyframes, shared by the threads verifying candidates (a match
+// keyframe of one lap is the match of the queries of every later lap).
+class DepthCache {
+ public:
+  explicit DepthCache(size_t capacity) : capacity_(std::max<size_t>(capacity, 1)) {}
+  std::shared_ptr<const SparseDepth> Get(int64_t frame, const std::function<SparseDepth()>& make) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      const auto it = entries_.find(frame);
+      if (it != entries_.end()) {
+        it->second.second = ++clock_;
+        return it->second.first;
+      }
+    }
+    auto depth = std::make_shared<const SparseDepth>(make());  // Outside the lock.
+    const std::lock_guard<std::mutex> lock(mutex_);
+    entries_[frame] = {depth, ++clock_};
+    if (entries_.size() > capacity_) {  // The least recently used one goes.
+      auto oldest = entries_.begin();
+      for (auto it = entries_.begin(); it != entries_.end(); ++it)
+        if (it->second.second < oldest->second.second) oldest = it;
+      entries_.erase(oldest);
+    }
+    return depth;
+  }
+
+ private:
+  size_t capacity_;
+  std::mutex mutex_;
+  uint64_t clock_ = 0;
+  std::unordered_map<int64_t, std::pair<std::shared_ptr<const SparseDepth>, uint64_t>> entries_;
+};
+
 // Depth at a keypoint: the nearest return in the window, averaged with the returns within 5 %
 // of it; 0 unless at least two agree.
 double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoopOptions& o) {
@@ -133,7 +191,7 @@ double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoop
 // when PnP found one with at least min_inliers.
 LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyframe& match,
                                    int64_t match_frame, LoopScanCache& scans,
-                                   const VisualLoopOptions& o,
+                                   const VisualLoopOptions& o, DepthCache* depths,
                                    std::optional<Rigid3d>* image_pose_out) {
   image_pose_out->reset();
   const Calibration& calibration = scans.calibration();
@@ -143,11 +201,20 @@ LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyf
   // Geometry in the chosen camera's frame; the points and poses returned are in camera 0's.
   const PinholeCamera camera = calibration.Camera(o.camera);
   const CameraChoice choice = CameraChoice::Of(calibration, o.camera);
-  const cv::Mat depth = ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
+  const std::vector<std::pair<int, int>> matches = MatchByNode(query, match, o);
+  // Too few matches for PnP to find min_inliers: the scan is not read.
+  if (static_cast<int>(matches.size()) < o.min_inliers) return c;
+  auto project = [&] {
+    return ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
+  };
+  const cv::Mat depth =
+      depths ? FromSparse(*depths->Get(match_frame, [&] { return ToSparse(project()); }),
+                          camera.height, camera.width)
+             : project();
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   std::vector<LoopPoint> points;
-  for (const auto& [qi, mi] : MatchByNode(query, match, o)) {
+  for (const auto& [qi, mi] : matches) {
     const vision::OrbKeypoint& km = match.keypoints[static_cast<size_t>(mi)];
     const vision::OrbKeypoint& kq = query.keypoints[static_cast<size_t>(qi)];
     const double z = DepthAt(depth, km.uv, o);
@@ -232,7 +299,7 @@ LoopCandidate VerifyVisualCandidate(const VisualKeyframe& query, const VisualKey
                                     int64_t query_frame, int64_t match_frame, LoopScanCache& scans,
                                     const VisualLoopOptions& o) {
   std::optional<Rigid3d> image_pose;
-  LoopCandidate c = MatchVisualCandidate(query, match, match_frame, scans, o, &image_pose);
+  LoopCandidate c = MatchVisualCandidate(query, match, match_frame, scans, o, nullptr, &image_pose);
   if (image_pose) RegisterVisualCandidate(*image_pose, query_frame, match_frame, scans, o, &c);
   return c;
 }
@@ -343,11 +410,12 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
   // 1. The images of every candidate (in parallel): matching, depth, PnP.
   std::vector<LoopCandidate> verified(to_verify.size());
   std::vector<std::optional<Rigid3d>> image_pose(to_verify.size());
+  DepthCache depths(512);
   ParallelFor(static_cast<int64_t>(to_verify.size()), threads, [&](int64_t vi) {
     const size_t v = static_cast<size_t>(vi);
     const auto [q, m] = to_verify[v];
     verified[v] = MatchVisualCandidate(described[q], described[m], keyframes.frames[m], scans, o,
-                                       &image_pose[v]);
+                                       &depths, &image_pose[v]);
     verified[v].query = keyframes.frames[q];
     verified[v].match = keyframes.frames[m];
     verified[v].descriptor_distance = to_verify_score[v];
