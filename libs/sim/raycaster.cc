@@ -2,7 +2,6 @@
 
 #include <embree3/rtcore.h>
 
-#include <array>
 #include <cmath>
 
 #include "core/check.h"
@@ -57,24 +56,14 @@ RayCaster::~RayCaster() {
 
 namespace {
 
-// The hit on triangle `prim`: its distance and normal computed again here in double precision
-// from the triangle's vertices and the ray, not taken from Embree, whose kernels round
-// differently on different CPUs (a float ULP or two in the distance and the normal, which
-// changed scan points and grey levels between machines). Only the triangle Embree found is
-// used; the distance Embree gave is kept where the ray runs along the plane.
-void FillHit(const Mesh& mesh, unsigned prim, float tfar, const Eigen::Vector3d& o,
+void FillHit(const Mesh& mesh, unsigned prim, float tfar, float nx, float ny, float nz,
              const Eigen::Vector3d& d, Hit* hit) {
-  const std::array<uint32_t, 3>& tri = mesh.triangles[prim];
-  const Eigen::Vector3d v0 = mesh.vertices[tri[0]].cast<double>();
-  const Eigen::Vector3d v1 = mesh.vertices[tri[1]].cast<double>();
-  const Eigen::Vector3d v2 = mesh.vertices[tri[2]].cast<double>();
-  Eigen::Vector3d n = (v1 - v0).cross(v2 - v0).normalized();
-  const double along = n.dot(d);
-  const double t = n.dot(v0 - o) / along;
-  hit->t = std::abs(along) > 1e-9 && std::abs(t - tfar) <= 1e-3 * (1 + tfar) ? t : tfar;
+  hit->t = tfar;
   hit->face = static_cast<int32_t>(mesh.triangle_face[prim]);
   hit->dynamic = -1;
-  if (along > 0) n = -n;
+  Eigen::Vector3d n(nx, ny, nz);
+  n.normalize();
+  if (n.dot(d) > 0) n = -n;
   hit->normal = n;
 }
 
@@ -101,7 +90,8 @@ Hit RayCaster::Intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, dou
   rtcIntersect1(impl_->scene, &context, &rh);
   Hit hit;
   if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-    FillHit(*impl_->mesh, rh.hit.primID, rh.ray.tfar, o, d, &hit);
+    FillHit(*impl_->mesh, rh.hit.primID, rh.ray.tfar, rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z, d,
+            &hit);
   }
   return hit;
 }
@@ -135,7 +125,8 @@ void RayCaster::Intersect8(const Eigen::Vector3d& o, const Eigen::Vector3d* d, i
   for (int i = 0; i < count; ++i) {
     hits[i] = Hit();
     if (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID) {
-      FillHit(*impl_->mesh, rh.hit.primID[i], rh.ray.tfar[i], o, d[i], &hits[i]);
+      FillHit(*impl_->mesh, rh.hit.primID[i], rh.ray.tfar[i], rh.hit.Ng_x[i], rh.hit.Ng_y[i],
+              rh.hit.Ng_z[i], d[i], &hits[i]);
     }
   }
 }
