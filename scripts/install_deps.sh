@@ -11,7 +11,7 @@ packages=(
   libeigen3-dev libopencv-dev libpcl-dev libceres-dev
   libcli11-dev nlohmann-json3-dev libhdf5-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev
-  libopencv-contrib-dev libembree-dev
+  libopencv-contrib-dev
   python3 python3-matplotlib python3-numpy
   clang-14 libclang-rt-14-dev llvm-14
 )

@@ -62,6 +62,7 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
   std::vector<uint8_t> ok(pts.size(), 0);
   Rng rng(seed);
   const NormalTable normal;
+  std::vector<int32_t> beam_hint(nb, -1);
   for (int a = 0; a < na; ++a) {
     const double az = kPi - 2 * kPi * a / na;  // Clockwise from behind.
     Rigid3d pose = world_from_velo;
@@ -74,7 +75,9 @@ PointCloud SimulateScan(const Scene& scene, const RayCaster& caster, const Rigid
     for (int b = 0; b < nb; ++b) {
       const Eigen::Vector3d d_velo(ce[b] * ca, ce[b] * sa, se[b]);
       const Eigen::Vector3d d = R * d_velo;
-      Hit hit = caster.Intersect(o, d, 0.05, options.max_range);
+      // Hinted by the beam's previous return (the caster's answer does not depend on it).
+      Hit hit = caster.Intersect(o, d, 0.05, options.max_range, beam_hint[b]);
+      if (hit.triangle >= 0) beam_hint[b] = hit.triangle;
       IntersectBoxes(moving, o, d, &hit);
       // Draw the random numbers for every slot so that the stream does not depend on hits.
       const double u_drop = rng.Uniform(), u_glass = rng.Uniform(), noise = normal.Sample(rng);

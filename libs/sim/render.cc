@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core.hpp>
+#include <vector>
 
 #include "core/check.h"
 #include "sim/random.h"
@@ -85,6 +86,44 @@ bool ShadeOnPlane(const Scene& scene, const Hit& centre, const Eigen::Vector3d& 
   return true;
 }
 
+// Separable Gaussian blur of a CV_32F image (radius ceil(4 sigma), edges replicated), written
+// out in scalar double arithmetic: the same bytes on every CPU (a library filter picks its SIMD
+// kernel by the CPU it runs on).
+void BlurRadiance(double sigma, cv::Mat* image) {
+  const int radius = std::max(1, static_cast<int>(std::ceil(4.0 * sigma)));
+  std::vector<double> kernel(2 * radius + 1);
+  double sum = 0;
+  for (int k = -radius; k <= radius; ++k) {
+    kernel[k + radius] = std::exp(-0.5 * k * k / (sigma * sigma));
+    sum += kernel[k + radius];
+  }
+  for (double& k : kernel) k /= sum;
+  const int w = image->cols, h = image->rows;
+  cv::Mat tmp(h, w, CV_32F);
+  for (int j = 0; j < h; ++j) {
+    const float* in = image->ptr<float>(j);
+    float* out = tmp.ptr<float>(j);
+    for (int i = 0; i < w; ++i) {
+      double acc = 0;
+      for (int k = -radius; k <= radius; ++k) {
+        acc += kernel[k + radius] * in[std::clamp(i + k, 0, w - 1)];
+      }
+      out[i] = static_cast<float>(acc);
+    }
+  }
+  std::vector<const float*> rows(2 * radius + 1);
+  for (int j = 0; j < h; ++j) {
+    for (int k = -radius; k <= radius; ++k)
+      rows[k + radius] = tmp.ptr<float>(std::clamp(j + k, 0, h - 1));
+    float* out = image->ptr<float>(j);
+    for (int i = 0; i < w; ++i) {
+      double acc = 0;
+      for (int k = 0; k <= 2 * radius; ++k) acc += kernel[k] * rows[k][i];
+      out[i] = static_cast<float>(acc);
+    }
+  }
+}
+
 }  // namespace
 
 cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCamera& camera,
@@ -107,13 +146,16 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
   Hit hits[8];
   for (int j = 0; j < h; ++j) {
     float* row = radiance.ptr<float>(j);
+    // The last triangle hit, the hint of the next ray (the caster's answer does not depend on it).
+    int32_t hint = -1;
     for (int i0 = 0; i0 < w; i0 += 8) {
       const int n = std::min(8, w - i0);
       for (int k = 0; k < n; ++k) {
         dirs[k] = RayThrough(R, camera, i0 + k, j);
       }
-      caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
+      caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits, hint);
       for (int k = 0; k < n; ++k) {
+        if (hits[k].triangle >= 0) hint = hits[k].triangle;
         IntersectBoxes(near, o, dirs[k], &hits[k]);
         row[i0 + k] =
             static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun, pixel_angle, options));
@@ -195,7 +237,8 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
           const Eigen::Vector2d& d = offsets[static_cast<size_t>(r % rays)];
           dirs[k] = RayThrough(R, camera, pixel[k] + d.x(), j + d.y());
         }
-        caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits);
+        caster.Intersect8(o, dirs, n, 0.05, options.max_range, hits,
+                          centre_hits[static_cast<size_t>(j) * w + pixel[0]].triangle);
         for (int k = 0; k < n; ++k) {
           IntersectBoxes(near, o, dirs[k], &hits[k]);
           row[pixel[k]] += weight * static_cast<float>(ShadeRay(scene, hits[k], o, dirs[k], sun,
@@ -204,10 +247,7 @@ cv::Mat RenderImage(const Scene& scene, const RayCaster& caster, const PinholeCa
       }
     }
   }
-  if (options.blur_sigma > 0) {
-    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), options.blur_sigma, options.blur_sigma,
-                     cv::BORDER_REPLICATE);
-  }
+  if (options.blur_sigma > 0) BlurRadiance(options.blur_sigma, &radiance);
   cv::Mat image(camera.height, camera.width, CV_8U);
   Rng rng(noise_seed);
   const NormalTable normal;

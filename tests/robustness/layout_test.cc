@@ -5,8 +5,12 @@
 // KITTI-360: the reader gives the tools the same frames, timestamps, calibration, scans, images
 // and ground truth, so the results are the same. The calibration's numbers are written with 12
 // (calib.txt) and 17 (KITTI-360 files) significant digits, so the poses may differ in the last
-// bits: measured 1.5e-13 (odometry), 5.3e-13 (local_map) and 2.3e-12 (global_opt); the
-// tolerance is 1e-9.
+// bits, and the optimisations carry that on: measured 6.0e-13 m (odometry), 3.5e-10 m
+// (local_map) and 9.9e-11 m (global_opt); the tolerance is 1e-9 (trajectories, translation APE).
+// The rotation APE goes through acos((trace - 1) / 2), which amplifies a pose difference by about
+// 1 / sin(theta) (theta: a frame's rotation error, about 0.01 rad here): the 9.9e-11 between the
+// global trajectories moves it by 8.4e-9 deg. Its tolerance is 1e-6 deg: what a pose difference
+// of 1e-9 gives at a rotation error of 1e-3 rad.
 //
 // Oxford: the same world, but the scans come in the LiDAR frame turned to the vehicle's axes
 // (the simulated LiDAR is rotated by a fraction of a degree against them, so voxel grids and
@@ -29,6 +33,7 @@ namespace {
 
 const std::string kDir = std::string(JVL_BINARY_DIR) + "/tests/robustness/";
 constexpr double kTolerance = 1e-9;
+constexpr double kRotationApeToleranceDeg = 1e-6;
 
 class LayoutTest : public ::testing::Test {
  protected:
@@ -91,8 +96,9 @@ TEST_F(LayoutTest, KittiAndKitti360LayoutsGiveTheSameMetrics) {
   for (size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(a["estimates"][i].at("label"), b["estimates"][i].at("label"));
     EXPECT_EQ(a["estimates"][i].at("frames_matched"), b["estimates"][i].at("frames_matched"));
-    for (const char* field : {"translation_m", "rotation_deg"})
-      EXPECT_NEAR(Ape(a, i, field), Ape(b, i, field), kTolerance) << i << " " << field;
+    EXPECT_NEAR(Ape(a, i, "translation_m"), Ape(b, i, "translation_m"), kTolerance) << i;
+    EXPECT_NEAR(Ape(a, i, "rotation_deg"), Ape(b, i, "rotation_deg"), kRotationApeToleranceDeg)
+        << i;
   }
 }
 
