@@ -11,7 +11,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 

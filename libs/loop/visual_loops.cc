@@ -139,25 +139,24 @@ cv::Mat FromSparse(const SparseDepth& sparse, int rows, int cols) {
 class DepthCache {
  public:
   explicit DepthCache(size_t capacity) : capacity_(std::max<size_t>(capacity, 1)) {}
-  std::shared_ptr<const SparseDepth> Get(int64_t frame, const std::function<SparseDepth()>& make) {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      const auto it = entries_.find(frame);
-      if (it != entries_.end()) {
-        it->second.second = ++clock_;
-        return it->second.first;
-      }
-    }
-    auto depth = std::make_shared<const SparseDepth>(make());  // Outside the lock.
+  // The depth kept for `frame`, or null.
+  std::shared_ptr<const SparseDepth> Find(int64_t frame) {
     const std::lock_guard<std::mutex> lock(mutex_);
-    entries_[frame] = {depth, ++clock_};
+    const auto it = entries_.find(frame);
+    if (it == entries_.end()) return nullptr;
+    it->second.second = ++clock_;
+    return it->second.first;
+  }
+  void Put(int64_t frame, SparseDepth depth) {
+    auto kept = std::make_shared<const SparseDepth>(std::move(depth));
+    const std::lock_guard<std::mutex> lock(mutex_);
+    entries_[frame] = {std::move(kept), ++clock_};
     if (entries_.size() > capacity_) {  // The least recently used one goes.
       auto oldest = entries_.begin();
       for (auto it = entries_.begin(); it != entries_.end(); ++it)
         if (it->second.second < oldest->second.second) oldest = it;
       entries_.erase(oldest);
     }
-    return depth;
   }
 
  private:
@@ -204,13 +203,14 @@ LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyf
   const std::vector<std::pair<int, int>> matches = MatchByNode(query, match, o);
   // Too few matches for PnP to find min_inliers: the scan is not read.
   if (static_cast<int>(matches.size()) < o.min_inliers) return c;
-  auto project = [&] {
-    return ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
-  };
-  const cv::Mat depth =
-      depths ? FromSparse(*depths->Get(match_frame, [&] { return ToSparse(project()); }),
-                          camera.height, camera.width)
-             : project();
+  // The match keyframe's depth as kept, else projected from its scan (and kept).
+  cv::Mat depth;
+  if (const auto kept = depths ? depths->Find(match_frame) : nullptr) {
+    depth = FromSparse(*kept, camera.height, camera.width);
+  } else {
+    depth = ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
+    if (depths) depths->Put(match_frame, ToSparse(depth));
+  }
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   std::vector<LoopPoint> points;

@@ -69,8 +69,7 @@ struct RayCaster::Impl {
   struct Node {
     float lo[3], hi[3];
     uint32_t index = 0;
-    uint16_t count = 0;
-    uint16_t axis = 0;
+    uint32_t count = 0;
   };
   // Reordered triangles: the mesh's float vertices (edges are formed in double at the test).
   struct Triangle {
@@ -196,12 +195,11 @@ void RayCaster::Impl::Build(std::vector<uint32_t>& order, const std::vector<Aabb
     } else if (best_axis < 0 && n > static_cast<uint32_t>(kLeafSize)) {
       // Coincident centroids: halve the range (deterministic) to bound the leaf size.
       mid = task.begin + n / 2;
-      best_axis = 0;
     }
     if (mid == task.begin || mid == task.end) {
       Node& leaf = nodes[task.node];
       leaf.index = task.begin;
-      leaf.count = static_cast<uint16_t>(n);
+      leaf.count = n;
       continue;
     }
     const uint32_t left = static_cast<uint32_t>(nodes.size()), right = left + 1;
@@ -209,7 +207,6 @@ void RayCaster::Impl::Build(std::vector<uint32_t>& order, const std::vector<Aabb
     nodes.emplace_back();
     nodes[task.node].index = left;
     nodes[task.node].count = 0;
-    nodes[task.node].axis = static_cast<uint16_t>(best_axis);
     tasks.push_back({right, mid, task.end});
     tasks.push_back({left, task.begin, mid});
   }
@@ -267,8 +264,8 @@ void RayCaster::Impl::Collapse() {
       if (nd.count > 0) {
         JVL_CHECK(nd.count <= 4, "BVH leaf of " << nd.count << " triangles");
         Leaf4 leaf{};
-        for (int l = 0; l < nd.count; ++l) {
-          const Triangle& tr = triangles[nd.index + static_cast<uint32_t>(l)];
+        for (uint32_t l = 0; l < nd.count; ++l) {
+          const Triangle& tr = triangles[nd.index + l];
           for (int k = 0; k < 3; ++k) {
             leaf.a[k][l] = tr.a[k];
             leaf.e1[k][l] = static_cast<double>(tr.b[k]) - tr.a[k];
@@ -277,7 +274,7 @@ void RayCaster::Impl::Collapse() {
           leaf.id[l] = tr.id;
         }
         out.index[c] = static_cast<uint32_t>(leaves.size());
-        out.count[c] = nd.count;
+        out.count[c] = static_cast<uint16_t>(nd.count);
         leaves.push_back(leaf);
       } else {
         out.index[c] = static_cast<uint32_t>(nodes4.size());
