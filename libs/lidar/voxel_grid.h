@@ -35,9 +35,9 @@ struct CellHash {
   }
 };
 
-// Static open-addressing map from cell key to a non-negative int (linear probing, power-of-two
-// table): lookups are several times faster than std::unordered_map, which dominated the
-// neighbourhood queries of a scan.
+// Insert-only open-addressing map from cell key to a non-negative int (linear probing,
+// power-of-two table; no erase: ImlsModel rebuilds it to drop keys): lookups are several times
+// faster than std::unordered_map, which dominated the neighbourhood queries of a scan.
 class CellMap {
  public:
   explicit CellMap(size_t expected = 0) { Reserve(expected); }
