@@ -48,10 +48,22 @@ int64_t FileSize(const std::string& path) {
 std::string ReadTextFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   JVL_CHECK(in.good(), path << ": cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
+  // A regular file is read in one piece into a string of its size (a scan is read this way for
+  // every frame of every stage); a stream of unknown length (a pipe, /dev/stdin) chunk by chunk.
+  std::string bytes;
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+    bytes.resize(static_cast<size_t>(st.st_size));
+    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    JVL_CHECK(!in.bad(), path << ": read error");
+    bytes.resize(static_cast<size_t>(in.gcount()));  // Shorter if it shrank meanwhile.
+    if (in.gcount() < st.st_size) return bytes;
+  }
+  char buffer[1 << 16];
+  while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0)
+    bytes.append(buffer, static_cast<size_t>(in.gcount()));
   JVL_CHECK(!in.bad(), path << ": read error");
-  return ss.str();
+  return bytes;
 }
 
 FileInfo DescribeFile(const std::string& path) {

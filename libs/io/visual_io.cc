@@ -118,22 +118,39 @@ void WriteVisualMap(const std::string& path, const VisualMapData& d, const Prove
   w.Commit(provenance);
 }
 
-VisualMapData ReadVisualMap(const std::string& path) {
-  H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
-  VisualMapData d;
-  d.camera = ReadCameraArray(r, "camera");
-  d.camera_choice = ReadCameraChoice(r);
+namespace {
+
+// The camera choice, the ORB pyramid and the keyframes of a visual map.
+void ReadHeader(H5Reader& r, const std::string& path, VisualMapData* d) {
+  d->camera_choice = ReadCameraChoice(r);
   const nlohmann::json orb = r.ReadJson("orb");
   JVL_CHECK(orb.is_object() && orb.contains("scale_factor") && orb["scale_factor"].is_number() &&
                 orb.contains("num_levels") && orb["num_levels"].is_number_integer(),
             path << ": attribute 'orb' lacks a numeric scale_factor / integer num_levels");
-  d.scale_factor = orb["scale_factor"].get<double>();
-  d.num_levels = orb["num_levels"].get<int>();
-  JVL_CHECK(std::isfinite(d.scale_factor) && d.scale_factor > 1.0 && d.scale_factor < 2.0 &&
-                d.num_levels >= 1 && d.num_levels <= 32,
-            path << ": attribute 'orb' has scale_factor " << d.scale_factor << " and num_levels "
-                 << d.num_levels << " (expected in (1, 2) and 1..32)");
-  d.keyframes = ReadTrajectoryGroup(r, "keyframes");
+  d->scale_factor = orb["scale_factor"].get<double>();
+  d->num_levels = orb["num_levels"].get<int>();
+  JVL_CHECK(std::isfinite(d->scale_factor) && d->scale_factor > 1.0 && d->scale_factor < 2.0 &&
+                d->num_levels >= 1 && d->num_levels <= 32,
+            path << ": attribute 'orb' has scale_factor " << d->scale_factor << " and num_levels "
+                 << d->num_levels << " (expected in (1, 2) and 1..32)");
+  d->keyframes = ReadTrajectoryGroup(r, "keyframes");
+}
+
+}  // namespace
+
+VisualMapData ReadVisualMapHeader(const std::string& path) {
+  H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
+  VisualMapData d;
+  ReadHeader(r, path, &d);
+  d.keyframes.Check((path + ": keyframes").c_str());
+  return d;
+}
+
+VisualMapData ReadVisualMap(const std::string& path) {
+  H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
+  VisualMapData d;
+  d.camera = ReadCameraArray(r, "camera");
+  ReadHeader(r, path, &d);
   d.keypoint_keyframe = r.ReadArray<int32_t>("keypoints/keyframe");
   d.keypoint_uv = r.ReadArray<float>("keypoints/uv", 2);
   d.keypoint_octave = r.ReadArray<int32_t>("keypoints/octave");

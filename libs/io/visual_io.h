@@ -67,5 +67,8 @@ void WarnIfCovisibilitySplit(const VisualMapData& data, const std::string& path)
 void WriteVisualMap(const std::string& path, const VisualMapData& data,
                     const Provenance& provenance);
 VisualMapData ReadVisualMap(const std::string& path);
+// Only camera_choice, scale_factor, num_levels and keyframes of a visual map, the rest left empty
+// (a fraction of a second where the whole map can take seconds).
+VisualMapData ReadVisualMapHeader(const std::string& path);
 
 }  // namespace jvl::io

@@ -21,6 +21,18 @@ void CellMap::Reserve(size_t expected) {
   }
 }
 
+void CellMap::Clear(size_t expected) {
+  size_t capacity = 16;
+  while (capacity < 2 * expected) capacity *= 2;
+  if (capacity == slots_.size()) {
+    std::fill(slots_.begin(), slots_.end(), Slot());
+  } else {
+    slots_.assign(capacity, Slot());
+  }
+  mask_ = capacity - 1;
+  size_ = 0;
+}
+
 int CellMap::Insert(uint64_t key, int value) {
   if (2 * (size_ + 1) > slots_.size()) Reserve(size_ + 1);
   size_t slot = CellHash()(key) & mask_;
@@ -41,7 +53,10 @@ std::vector<size_t> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, 
     return kept;
   }
   const double inv = 1.0 / voxel_size;
-  CellMap seen(points.size());
+  // Kept per thread: scans of one drive need tables of the same size, which are then cleared
+  // instead of allocated (and page-faulted in) again for every scan.
+  thread_local CellMap seen;
+  seen.Clear(points.size());
   kept.reserve(points.size() / 2);
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3i c = CellOf(points[i], inv);

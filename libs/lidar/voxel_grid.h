@@ -42,6 +42,8 @@ class CellMap {
  public:
   explicit CellMap(size_t expected = 0) { Reserve(expected); }
   void Reserve(size_t expected);
+  // Empties the map, sized for `expected` keys (its memory kept where the size is the same).
+  void Clear(size_t expected);
   // Inserts key -> value if key is absent; returns the value stored for key.
   int Insert(uint64_t key, int value);
   // The value of key, or -1.

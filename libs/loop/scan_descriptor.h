@@ -26,6 +26,11 @@ struct ScanDescriptor {
   Eigen::VectorXf ring_key;
 };
 
+// The sector of azimuth atan2(y, x) (taken in [0, 2 pi)) among `sectors`: the same as
+// min(sectors - 1, floor(azimuth / (2 pi) x sectors)) with atan2, always, at less cost (a
+// polynomial, with atan2 only next to a sector boundary). (x, y) must not be (0, 0).
+int AzimuthSector(double x, double y, int sectors);
+
 // points: sensor frame (x forward, y left, z up).
 ScanDescriptor ComputeScanDescriptor(const std::vector<Eigen::Vector3d>& points,
                                      const ScanDescriptorOptions& options);

@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "geometry/rigid3.h"
 
@@ -47,6 +50,47 @@ std::vector<Eigen::Vector3d> Scan(const std::vector<Eigen::Vector3d>& world,
 
 Rigid3d Yawed(double yaw, const Eigen::Vector3d& t = Eigen::Vector3d::Zero()) {
   return Rigid3d(ExpSO3(Eigen::Vector3d(0, 0, yaw)), t);
+}
+
+// The sector as defined: atan2's azimuth in [0, 2 pi), scaled and floored.
+int ReferenceSector(double x, double y, int sectors) {
+  const double pi = 3.14159265358979323846;
+  double azimuth = std::atan2(y, x);
+  if (azimuth < 0) azimuth += 2 * pi;
+  return std::min(sectors - 1, static_cast<int>(azimuth / (2 * pi) * sectors));
+}
+
+TEST(ScanDescriptor, AzimuthSectorIsAtan2sSector) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::uniform_real_distribution<double> log_scale(-3, 2.5);
+  for (const int sectors : {4, 7, 60, 360, 3600}) {
+    // Random directions at ranges from 1 mm to 300 m.
+    for (int i = 0; i < 300000; ++i) {
+      const double scale = std::pow(10.0, log_scale(rng));
+      const double x = scale * u(rng), y = scale * u(rng);
+      if (x == 0 && y == 0) continue;
+      ASSERT_EQ(AzimuthSector(x, y, sectors), ReferenceSector(x, y, sectors))
+          << x << " " << y << " " << sectors;
+    }
+    // On and beside every sector boundary: from 1e-12 to 1e-2 rad either side, where the
+    // polynomial alone would be wrong.
+    for (int k = 0; k <= sectors; ++k) {
+      const double boundary = 2 * 3.14159265358979323846 * k / sectors;
+      for (double offset = 1e-12; offset < 1e-2; offset *= 1.7) {
+        for (const double angle : {boundary, boundary - offset, boundary + offset}) {
+          const double x = 25 * std::cos(angle), y = 25 * std::sin(angle);
+          ASSERT_EQ(AzimuthSector(x, y, sectors), ReferenceSector(x, y, sectors))
+              << angle << " " << sectors;
+        }
+      }
+    }
+    // The axes, signed zeros included.
+    for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+             {1, 0}, {1, -0.0}, {-1, 0}, {-1, -0.0}, {0, 1}, {-0.0, 1}, {0, -1}, {-0.0, -1}}) {
+      EXPECT_EQ(AzimuthSector(x, y, sectors), ReferenceSector(x, y, sectors)) << x << " " << y;
+    }
+  }
 }
 
 TEST(ScanDescriptor, RingKeyAndDistanceIgnoreTheSensorsYaw) {

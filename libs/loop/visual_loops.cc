@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <opencv2/calib3d.hpp>
@@ -68,14 +67,17 @@ namespace {
 // keeps its best query feature. Pairs (query index, match index), by query index.
 std::vector<std::pair<int, int>> MatchByNode(const VisualKeyframe& q, const VisualKeyframe& m,
                                              const VisualLoopOptions& o) {
-  std::map<int32_t, std::vector<int>> by_node;
-  for (size_t j = 0; j < m.nodes.size(); ++j) by_node[m.nodes[j]].push_back(static_cast<int>(j));
+  // The match features by (node, index).
+  std::vector<std::pair<int32_t, int>> by_node(m.nodes.size());
+  for (size_t j = 0; j < m.nodes.size(); ++j) by_node[j] = {m.nodes[j], static_cast<int>(j)};
+  std::sort(by_node.begin(), by_node.end());
   std::vector<int> best_query(m.descriptors.size(), -1), best_distance(m.descriptors.size(), 257);
   for (size_t i = 0; i < q.descriptors.size(); ++i) {
-    const auto it = by_node.find(q.nodes[i]);
-    if (it == by_node.end()) continue;
+    auto it = std::lower_bound(by_node.begin(), by_node.end(),
+                               std::make_pair(q.nodes[i], std::numeric_limits<int>::min()));
     int best = -1, d1 = 257, d2 = 257;
-    for (const int j : it->second) {
+    for (; it != by_node.end() && it->first == q.nodes[i]; ++it) {
+      const int j = it->second;
       const int d =
           vision::HammingDistance(q.descriptors[i], m.descriptors[static_cast<size_t>(j)]);
       if (d < d1) {
@@ -168,10 +170,12 @@ class DepthCache {
 
 // Depth at a keypoint: the nearest return in the window, averaged with the returns within 5 %
 // of it; 0 unless at least two agree.
-double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoopOptions& o) {
+// `found` is scratch space.
+double DepthAt(const cv::Mat& depth, const Eigen::Vector2f& uv, const VisualLoopOptions& o,
+               std::vector<float>& found) {
   const int r = static_cast<int>(std::ceil(o.depth_window_px));
   const int u0 = static_cast<int>(uv.x()), v0 = static_cast<int>(uv.y());
-  std::vector<float> found;
+  found.clear();
   for (int v = std::max(0, v0 - r); v <= std::min(depth.rows - 1, v0 + r); ++v)
     for (int u = std::max(0, u0 - r); u <= std::min(depth.cols - 1, u0 + r); ++u)
       if (const float d = depth.at<float>(v, u); d > 0) found.push_back(d);
@@ -214,10 +218,11 @@ LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyf
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
   std::vector<LoopPoint> points;
+  std::vector<float> scratch;
   for (const auto& [qi, mi] : matches) {
     const vision::OrbKeypoint& km = match.keypoints[static_cast<size_t>(mi)];
     const vision::OrbKeypoint& kq = query.keypoints[static_cast<size_t>(qi)];
-    const double z = DepthAt(depth, km.uv, o);
+    const double z = DepthAt(depth, km.uv, o, scratch);
     if (z <= 0) continue;
     LoopPoint point;
     const Eigen::Vector3d p_camera = z * camera.Unproject(km.uv.cast<double>());
@@ -325,20 +330,21 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
   spdlog::debug("visual detector: {} keyframes described in {:.2f} s", n, timer.ElapsedSeconds());
   timer.Reset();
 
-  // Inverted index: word -> keyframes holding it, filled as the queries advance (a query sees
-  // only the keyframes before it).
+  // Inverted index: word -> keyframes holding it, in keyframe order (a query looks only at the
+  // keyframes before it).
   std::vector<std::vector<size_t>> inverted(static_cast<size_t>(vocabulary.num_words()));
-  struct Group {
-    long lo, hi;      // Keyframe indices.
-    int consecutive;  // Query keyframes in a row that had an overlapping group, this one included.
-  };
-  std::vector<Group> previous_groups;
-  std::vector<std::pair<size_t, size_t>> to_verify;  // (query, match) keyframe indices.
-  std::vector<double> to_verify_score;
+  for (size_t q = 0; q < n; ++q)
+    for (const auto& [word, weight] : described[q].bow)
+      inverted[static_cast<size_t>(word)].push_back(q);
+  // The scored candidates of every query (in parallel; they depend on the query alone): the
+  // earlier keyframes far enough back that share enough words with it and score at least as
+  // high as its own neighbours (the keyframes just before it), by keyframe index.
   const long nb = o.group_keyframes;
-  for (size_t q = 0; q < n; ++q) {
+  std::vector<std::vector<std::pair<size_t, double>>> scored(n);
+  ParallelFor(static_cast<int64_t>(n), threads, [&](int64_t qi) {
+    const size_t q = static_cast<size_t>(qi);
     const BowVector& bow = described[q].bow;
-    // The lowest score against the query's own neighbours (the keyframes just before it).
+    // The lowest score against the query's own neighbours.
     double min_score = 1;
     bool have_neighbour = false;
     for (long b = 1; b <= std::max(nb, 1L) && static_cast<long>(q) - b >= 0; ++b) {
@@ -347,22 +353,33 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
       have_neighbour = true;
     }
     if (!have_neighbour) min_score = 0;
-    // Earlier keyframes far enough back that share words with the query.
     std::vector<int> common(q, 0);
     for (const auto& [word, weight] : bow)
-      for (const size_t j : inverted[static_cast<size_t>(word)]) ++common[j];
+      for (const size_t j : inverted[static_cast<size_t>(word)]) {
+        if (j >= q) break;
+        ++common[j];
+      }
     int most = 0;
     for (size_t j = 0; j < q; ++j)
       if (path[q] - path[j] >= o.lidar.min_separation_m) most = std::max(most, common[j]);
-    std::vector<double> score(q, -1);  // >= 0: a candidate.
-    if (most > 0) {
-      const double least = o.min_common_ratio * most;
-      for (size_t j = 0; j < q; ++j) {
-        if (path[q] - path[j] < o.lidar.min_separation_m || common[j] < least) continue;
-        const double s = Vocabulary::Score(bow, described[j].bow);
-        if (s >= min_score) score[j] = s;
-      }
+    if (most == 0) return;
+    const double least = o.min_common_ratio * most;
+    for (size_t j = 0; j < q; ++j) {
+      if (path[q] - path[j] < o.lidar.min_separation_m || common[j] < least) continue;
+      const double s = Vocabulary::Score(bow, described[j].bow);
+      if (s >= min_score) scored[q].emplace_back(j, s);
     }
+  });
+  struct Group {
+    long lo, hi;      // Keyframe indices.
+    int consecutive;  // Query keyframes in a row that had an overlapping group, this one included.
+  };
+  std::vector<Group> previous_groups;
+  std::vector<std::pair<size_t, size_t>> to_verify;  // (query, match) keyframe indices.
+  std::vector<double> to_verify_score;
+  for (size_t q = 0; q < n; ++q) {
+    std::vector<double> score(q, -1);  // >= 0: a candidate.
+    for (const auto& [j, s] : scored[q]) score[j] = s;
     // Groups: a candidate with its candidate neighbours; the accumulated score, its best member.
     std::vector<std::pair<double, size_t>> groups;  // (accumulated, best member)
     double best_accumulated = 0;
@@ -399,7 +416,6 @@ LoopResult DetectVisualLoops(const Trajectory& keyframes,
       }
     }
     previous_groups = std::move(current);
-    for (const auto& [word, weight] : bow) inverted[static_cast<size_t>(word)].push_back(q);
   }
 
   // Verification (independent, in parallel; results in their slots), then the best accepted

@@ -107,22 +107,6 @@ std::vector<cv::KeyPoint> DetectLevel(const cv::Mat& level, int wanted, const Or
 
 }  // namespace
 
-int HammingDistance(const Descriptor& a, const Descriptor& b) {
-  int d = 0;
-  for (int i = 0; i < 32; i += 8) {
-    uint64_t x, y;
-    std::memcpy(&x, a.data() + i, 8);
-    std::memcpy(&y, b.data() + i, 8);
-    // Bit count without relying on a hardware popcount instruction (SWAR reduction).
-    uint64_t v = x ^ y;
-    v = v - ((v >> 1) & 0x5555555555555555ULL);
-    v = (v & 0x3333333333333333ULL) + ((v >> 2) & 0x3333333333333333ULL);
-    v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0fULL;
-    d += static_cast<int>((v * 0x0101010101010101ULL) >> 56);
-  }
-  return d;
-}
-
 void OrbOptions::Check() const {
   JVL_CHECK(num_features > 0, "orb: num_features must be > 0, got " << num_features);
   JVL_CHECK(num_levels >= 1 && num_levels <= 16, "orb: num_levels must be in [1, 16]");

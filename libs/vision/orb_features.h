@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -14,8 +15,22 @@ namespace jvl::vision {
 
 using Descriptor = std::array<uint8_t, 32>;
 
-// Hamming distance of two 256-bit descriptors.
-int HammingDistance(const Descriptor& a, const Descriptor& b);
+// Hamming distance of two 256-bit descriptors (inline: the matchers' innermost loop).
+inline int HammingDistance(const Descriptor& a, const Descriptor& b) {
+  int d = 0;
+  for (int i = 0; i < 32; i += 8) {
+    uint64_t x, y;
+    std::memcpy(&x, a.data() + i, 8);
+    std::memcpy(&y, b.data() + i, 8);
+    // Bit count without relying on a hardware popcount instruction (SWAR reduction).
+    uint64_t v = x ^ y;
+    v = v - ((v >> 1) & 0x5555555555555555ULL);
+    v = (v & 0x3333333333333333ULL) + ((v >> 2) & 0x3333333333333333ULL);
+    v = (v + (v >> 4)) & 0x0f0f0f0f0f0f0f0fULL;
+    d += static_cast<int>((v * 0x0101010101010101ULL) >> 56);
+  }
+  return d;
+}
 
 struct OrbOptions {
   int num_features = 2000;     // Total over all levels (ORB-SLAM2 KITTI setting).

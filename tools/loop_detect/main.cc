@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -22,6 +23,7 @@
 #include "core/check.h"
 #include "core/progress.h"
 #include "core/strings.h"
+#include "core/threads.h"
 #include "io/dataset.h"
 #include "io/loops_io.h"
 #include "io/trajectory_io.h"
@@ -258,19 +260,41 @@ int main(int argc, char** argv) {
     // The visual map's keypoints of a keyframe: rows [first, last) of keypoints/*.
     io::VisualMapData map;
     std::unordered_map<int64_t, std::pair<size_t, size_t>> rows;
+    // The features of the keyframes the visual map lacks, extracted while the map is read.
+    std::unordered_map<int64_t, vision::OrbFeatures> extracted_early;
     if (use_visual && !visual_path.empty()) {
       tool.AddInput(visual_path);
-      map = io::ReadVisualMap(visual_path);
-      JVL_CHECK(camera_option->count() == 0 || map.camera_choice.index == visual_options.camera,
-                visual_path << " was built from camera " << map.camera_choice.index
+      const io::VisualMapData header = io::ReadVisualMapHeader(visual_path);
+      JVL_CHECK(camera_option->count() == 0 || header.camera_choice.index == visual_options.camera,
+                visual_path << " was built from camera " << header.camera_choice.index
                             << ", not --camera " << visual_options.camera);
-      visual_options.camera = map.camera_choice.index;
-      JVL_CHECK(std::abs(map.scale_factor - visual_options.orb.scale_factor) < 1e-9 &&
-                    map.num_levels == visual_options.orb.num_levels,
-                visual_path << ": ORB pyramid " << map.num_levels << " levels x "
-                            << map.scale_factor << ", the visual detector uses "
+      visual_options.camera = header.camera_choice.index;
+      JVL_CHECK(std::abs(header.scale_factor - visual_options.orb.scale_factor) < 1e-9 &&
+                    header.num_levels == visual_options.orb.num_levels,
+                visual_path << ": ORB pyramid " << header.num_levels << " levels x "
+                            << header.scale_factor << ", the visual detector uses "
                             << visual_options.orb.num_levels << " x "
                             << visual_options.orb.scale_factor);
+      dataset->CheckCamera(visual_options.camera);
+      std::vector<int64_t> missing;
+      for (const int64_t f : keyframes.frames)
+        if (!header.keyframes.IndexOf(f)) missing.push_back(f);
+      // One thread reads the map (HDF5 is read by one thread at a time), the others extract.
+      std::vector<vision::OrbFeatures> features(missing.size());
+      auto reading = std::async(std::launch::async, [&] { return io::ReadVisualMap(visual_path); });
+      try {
+        ParallelFor(static_cast<int64_t>(missing.size()), tool.threads(), [&](int64_t i) {
+          features[static_cast<size_t>(i)] = vision::ExtractOrb(
+              dataset->LoadImage(missing[static_cast<size_t>(i)], visual_options.camera),
+              visual_options.orb);
+        });
+      } catch (...) {
+        reading.wait();  // The reader holds references to this scope.
+        throw;
+      }
+      map = reading.get();
+      for (size_t i = 0; i < missing.size(); ++i)
+        extracted_early.emplace(missing[i], std::move(features[i]));
       try {
         rows = mapping::KeypointRowsByFrame(map);
       } catch (const Error& e) {
@@ -306,6 +330,8 @@ int main(int argc, char** argv) {
         const auto it = rows.find(f);
         if (it == rows.end()) {
           ++extracted;
+          if (const auto early = extracted_early.find(f); early != extracted_early.end())
+            return std::move(early->second);
           return vision::ExtractOrb(dataset->LoadImage(f, visual_options.camera),
                                     visual_options.orb);
         }
