@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <unordered_map>
 
 #include "core/check.h"
 #include "core/threads.h"
@@ -141,50 +142,20 @@ LoopScanCache::LoopScanCache(std::function<PointCloud(int64_t)> load_scan,
     : load_scan_(std::move(load_scan)),
       calibration_(calibration),
       options_(options),
-      capacity_(std::max<size_t>(capacity, 1)) {}
+      cache_(capacity) {}
 
 std::shared_ptr<const LoopScan> LoopScanCache::Get(int64_t frame) {
-  std::shared_ptr<Slot> slot;
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    auto it = slots_.find(frame);
-    if (it != slots_.end()) {
-      recent_.erase(it->second.second);
-    } else {
-      it = slots_.emplace(frame, std::make_pair(std::make_shared<Slot>(), recent_.end())).first;
-    }
-    recent_.push_front(frame);
-    it->second.second = recent_.begin();
-    slot = it->second.first;
-    while (recent_.size() > capacity_) {  // The slot's holders keep its scan alive.
-      slots_.erase(recent_.back());
-      recent_.pop_back();
-    }
-  }
-  const std::lock_guard<std::mutex> lock(slot->mutex);
-  if (!slot->scan)
-    slot->scan = std::make_shared<const LoopScan>(load_scan_(frame), calibration_, options_);
-  return slot->scan;
+  return cache_.Get(frame, [&] { return LoopScan(load_scan_(frame), calibration_, options_); });
 }
 
-std::shared_ptr<const LoopScan> LoopScanCache::Find(int64_t frame) {
-  std::shared_ptr<Slot> slot;
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = slots_.find(frame);
-    if (it == slots_.end()) return nullptr;
-    slot = it->second.first;
-  }
-  const std::lock_guard<std::mutex> lock(slot->mutex);
-  return slot->scan;
-}
+std::shared_ptr<const LoopScan> LoopScanCache::Find(int64_t frame) { return cache_.Find(frame); }
 
 void LoopScanCache::Prepare(const std::vector<int64_t>& frames, int threads) {
   // The first `capacity` distinct frames in the order given (the order they are needed in).
   std::vector<int64_t> first;
   std::unordered_map<int64_t, char> seen;
   for (const int64_t f : frames) {
-    if (first.size() >= capacity_) break;
+    if (first.size() >= cache_.capacity()) break;
     if (seen.emplace(f, 1).second) first.push_back(f);
   }
   ParallelFor(static_cast<int64_t>(first.size()), threads,

@@ -12,13 +12,11 @@
 
 #include <cstdint>
 #include <functional>
-#include <list>
 #include <memory>
-#include <mutex>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
+#include "core/lru_cache.h"
 #include "geometry/calibration.h"
 #include "geometry/point_cloud.h"
 #include "geometry/rigid3.h"
@@ -215,18 +213,10 @@ class LoopScanCache {
   const Calibration& calibration() const { return calibration_; }
 
  private:
-  struct Slot {
-    std::mutex mutex;
-    std::shared_ptr<const LoopScan> scan;
-  };
   std::function<PointCloud(int64_t)> load_scan_;
   Calibration calibration_;
   LidarLoopOptions options_;
-  size_t capacity_;
-  std::mutex mutex_;
-  std::list<int64_t> recent_;  // Most recently used first.
-  std::unordered_map<int64_t, std::pair<std::shared_ptr<Slot>, std::list<int64_t>::iterator>>
-      slots_;
+  LruCache<int64_t, LoopScan> cache_;
 };
 
 }  // namespace jvl::loop

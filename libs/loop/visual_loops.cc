@@ -6,13 +6,12 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <optional>
-#include <unordered_map>
 
 #include "core/check.h"
+#include "core/lru_cache.h"
 #include "core/threads.h"
 #include "core/timer.h"
 
@@ -136,37 +135,9 @@ cv::Mat FromSparse(const SparseDepth& sparse, int rows, int cols) {
   return depth;
 }
 
-// The depth of the latest match keyframes, shared by the threads verifying candidates (a match
-// keyframe of one lap is the match of the queries of every later lap).
-class DepthCache {
- public:
-  explicit DepthCache(size_t capacity) : capacity_(std::max<size_t>(capacity, 1)) {}
-  // The depth kept for `frame`, or null.
-  std::shared_ptr<const SparseDepth> Find(int64_t frame) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = entries_.find(frame);
-    if (it == entries_.end()) return nullptr;
-    it->second.second = ++clock_;
-    return it->second.first;
-  }
-  void Put(int64_t frame, SparseDepth depth) {
-    auto kept = std::make_shared<const SparseDepth>(std::move(depth));
-    const std::lock_guard<std::mutex> lock(mutex_);
-    entries_[frame] = {std::move(kept), ++clock_};
-    if (entries_.size() > capacity_) {  // The least recently used one goes.
-      auto oldest = entries_.begin();
-      for (auto it = entries_.begin(); it != entries_.end(); ++it)
-        if (it->second.second < oldest->second.second) oldest = it;
-      entries_.erase(oldest);
-    }
-  }
-
- private:
-  size_t capacity_;
-  std::mutex mutex_;
-  uint64_t clock_ = 0;
-  std::unordered_map<int64_t, std::pair<std::shared_ptr<const SparseDepth>, uint64_t>> entries_;
-};
+// The depth of the latest match keyframes (sparse), shared by the threads verifying candidates
+// (a match keyframe of one lap is the match of the queries of every later lap).
+using DepthCache = LruCache<int64_t, SparseDepth>;
 
 // Depth at a keypoint: the nearest return in the window, averaged with the returns within 5 %
 // of it; 0 unless at least two agree.
@@ -208,12 +179,15 @@ LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyf
   // Too few matches for PnP to find min_inliers: the scan is not read.
   if (static_cast<int>(matches.size()) < o.min_inliers) return c;
   // The match keyframe's depth as kept, else projected from its scan (and kept).
-  cv::Mat depth;
-  if (const auto kept = depths ? depths->Find(match_frame) : nullptr) {
-    depth = FromSparse(*kept, camera.height, camera.width);
-  } else {
+  cv::Mat depth;  // Projected here, or rebuilt from the depth kept.
+  auto project = [&] {
     depth = ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
-    if (depths) depths->Put(match_frame, ToSparse(depth));
+    return ToSparse(depth);
+  };
+  if (!depths) {
+    project();
+  } else if (const auto kept = depths->Get(match_frame, project); depth.empty()) {
+    depth = FromSparse(*kept, camera.height, camera.width);
   }
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;
