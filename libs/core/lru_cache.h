@@ -11,9 +11,10 @@
 namespace jvl {
 
 // Keeps the values of the `capacity` most recently used keys. A missing value is made by the
-// caller's function outside the cache's lock, once: other threads asking for the same key wait
-// for it, threads asking for other keys do not. A value dropped from the cache lives on while a
-// caller holds it.
+// caller's function outside the cache's lock, once while its key is kept: other threads asking
+// for the same key wait for it, threads asking for other keys do not (a key dropped while its
+// value is being made, and asked for again, is made again). A value dropped from the cache lives
+// on while a caller holds it.
 template <typename Key, typename Value>
 class LruCache {
  public:
@@ -25,14 +26,19 @@ class LruCache {
     std::shared_ptr<Slot> slot;
     {
       const std::lock_guard<std::mutex> lock(mutex_);
+      recent_.push_front(key);  // First: nothing below is left half done if it throws.
       auto it = slots_.find(key);
       if (it != slots_.end()) {
         recent_.erase(it->second.second);
+        it->second.second = recent_.begin();
       } else {
-        it = slots_.emplace(key, std::make_pair(std::make_shared<Slot>(), recent_.end())).first;
+        try {
+          it = slots_.emplace(key, std::make_pair(std::make_shared<Slot>(), recent_.begin())).first;
+        } catch (...) {
+          recent_.pop_front();
+          throw;
+        }
       }
-      recent_.push_front(key);
-      it->second.second = recent_.begin();
       slot = it->second.first;
       while (recent_.size() > capacity_) {  // The least recently used one goes.
         slots_.erase(recent_.back());

@@ -78,6 +78,29 @@ TEST(VisualIo, RoundTrip) {
   fs::remove(path);
 }
 
+// The header holds the same camera choice, pyramid and keyframes as the whole map, and nothing
+// else.
+TEST(VisualIo, HeaderIsTheMapsHead) {
+  VisualMapData d = MakeMap();
+  d.camera_choice = {2, Eigen::Vector3d(0.061, -0.0003, 0.0062)};
+  const std::string path = TempPath("head.h5").string();
+  WriteVisualMap(path, d, Provenance{});
+  const VisualMapData whole = ReadVisualMap(path);
+  const VisualMapData header = ReadVisualMapHeader(path);
+  EXPECT_EQ(header.camera_choice.index, 2);
+  EXPECT_EQ(header.camera_choice.offset, whole.camera_choice.offset);
+  EXPECT_EQ(header.scale_factor, whole.scale_factor);
+  EXPECT_EQ(header.num_levels, whole.num_levels);
+  EXPECT_EQ(header.keyframes.frames, whole.keyframes.frames);
+  ASSERT_EQ(header.keyframes.size(), whole.keyframes.size());
+  for (size_t i = 0; i < header.keyframes.size(); ++i)
+    EXPECT_EQ(header.keyframes.world_from_cam[i].ToArray(),
+              whole.keyframes.world_from_cam[i].ToArray());
+  EXPECT_TRUE(header.keypoint_keyframe.empty());
+  EXPECT_TRUE(header.mappoint_position.empty());
+  fs::remove(path);
+}
+
 // The camera choice of a map built from another camera is kept; a camera-0 map has none written.
 TEST(VisualIo, CameraChoiceRoundTrip) {
   const std::string path = TempPath("cam.h5").string();

@@ -28,7 +28,7 @@ struct ScanDescriptor {
 
 // The sector of azimuth atan2(y, x) (taken in [0, 2 pi)) among `sectors`: the same as
 // min(sectors - 1, floor(azimuth / (2 pi) x sectors)) with atan2, always, at less cost (a
-// polynomial, with atan2 only next to a sector boundary). (x, y) must not be (0, 0).
+// polynomial, with atan2 only next to a sector boundary). x and y must be finite.
 int AzimuthSector(double x, double y, int sectors);
 
 // points: sensor frame (x forward, y left, z up).

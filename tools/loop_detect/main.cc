@@ -279,19 +279,17 @@ int main(int argc, char** argv) {
       std::vector<int64_t> missing;
       for (const int64_t f : keyframes.frames)
         if (!header.keyframes.IndexOf(f)) missing.push_back(f);
-      // One thread reads the map (HDF5 is read by one thread at a time), the others extract.
+      // A thread of its own reads the map (HDF5 is read by one thread at a time) while the
+      // worker threads extract (reading is mostly waiting on inflate and the disk, so the
+      // threads overlap). A map that cannot be read is reported after the extraction; an image
+      // that cannot be read first (the future's destructor waits for the reader).
       std::vector<vision::OrbFeatures> features(missing.size());
       auto reading = std::async(std::launch::async, [&] { return io::ReadVisualMap(visual_path); });
-      try {
-        ParallelFor(static_cast<int64_t>(missing.size()), tool.threads(), [&](int64_t i) {
-          features[static_cast<size_t>(i)] = vision::ExtractOrb(
-              dataset->LoadImage(missing[static_cast<size_t>(i)], visual_options.camera),
-              visual_options.orb);
-        });
-      } catch (...) {
-        reading.wait();  // The reader holds references to this scope.
-        throw;
-      }
+      ParallelFor(static_cast<int64_t>(missing.size()), tool.threads(), [&](int64_t i) {
+        features[static_cast<size_t>(i)] = vision::ExtractOrb(
+            dataset->LoadImage(missing[static_cast<size_t>(i)], visual_options.camera),
+            visual_options.orb);
+      });
       map = reading.get();
       for (size_t i = 0; i < missing.size(); ++i)
         extracted_early.emplace(missing[i], std::move(features[i]));
