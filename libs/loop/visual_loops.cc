@@ -178,8 +178,9 @@ LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyf
   const std::vector<std::pair<int, int>> matches = MatchByNode(query, match, o);
   // Too few matches for PnP to find min_inliers: the scan is not read.
   if (static_cast<int>(matches.size()) < o.min_inliers) return c;
-  // The match keyframe's depth as kept, else projected from its scan (and kept).
-  cv::Mat depth;  // Projected here, or rebuilt from the depth kept.
+  // The match keyframe's depth: projected from its scan (and kept), or rebuilt from the depth
+  // kept.
+  cv::Mat depth;
   auto project = [&] {
     depth = ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
     return ToSparse(depth);
