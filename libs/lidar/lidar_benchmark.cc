@@ -99,6 +99,25 @@ void BM_ComputeSurface(benchmark::State& state) {
 }
 BENCHMARK(BM_ComputeSurface)->Unit(benchmark::kMillisecond);
 
+// The whole preprocessing (range cut, voxel filter, outliers, ground, small objects) of a raw
+// scan of the KITTI 04 excerpt (skipped without it).
+void BM_PreprocessScan(benchmark::State& state) {
+  const std::string seq =
+      std::string(JVL_SOURCE_DIR) + "/../shared/data/kitti_odometry_04_f0-50/sequences/04";
+  if (!std::filesystem::exists(seq)) {
+    state.SkipWithError("the KITTI 04 excerpt is not at ../shared/data");
+    return;
+  }
+  const auto dataset = jvl::io::OpenDataset(seq);
+  const jvl::PointCloud scan = dataset->LoadScan(5);
+  for (auto _ : state) {
+    const auto pre = jvl::lidar::PreprocessScan(scan, dataset->calibration().cam0_from_velo,
+                                                jvl::lidar::PreprocessOptions(), 1);
+    benchmark::DoNotOptimize(pre.points.data());
+  }
+}
+BENCHMARK(BM_PreprocessScan)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();

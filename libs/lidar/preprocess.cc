@@ -14,6 +14,7 @@
 #include <numeric>
 
 #include "core/check.h"
+#include "core/threads.h"
 #include "lidar/voxel_grid.h"
 
 namespace jvl::lidar {
@@ -115,14 +116,14 @@ std::vector<uint8_t> RadiusOutlierMask(const std::vector<Eigen::Vector3d>& point
   if (points.empty() || radius <= 0 || min_neighbors <= 0) return keep;
   if (method == "grid") {
     const PointGrid grid(points, radius);
-    const double r2 = radius * radius;
-    grid.ForEachCell(threads, [&](const std::vector<int>& members, const std::vector<int>& cand) {
-      for (const int i : members) {
-        int count = -1;  // The point itself is a candidate.
-        for (const int j : cand) {
-          if ((points[j] - points[i]).squaredNorm() <= r2 && ++count >= min_neighbors) break;
-        }
-        keep[i] = count >= min_neighbors;
+    // A point counts itself: it is kept with min_neighbors others within the radius. Counting
+    // stops there, mostly within the point's own cell (the nearer cells are searched first).
+    const int needed = min_neighbors + 1;
+    constexpr int64_t kChunk = 1024;
+    const int64_t n = static_cast<int64_t>(points.size());
+    ParallelFor((n + kChunk - 1) / kChunk, threads, [&](int64_t chunk) {
+      for (int64_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
+        keep[i] = grid.CountWithin(points[i], radius, needed) >= needed;
       }
     });
     return keep;
@@ -187,12 +188,21 @@ std::vector<uint8_t> SmallObjectMask(const std::vector<Eigen::Vector3d>& points,
   CellMap cell_id(points.size() / 4);
   std::vector<Eigen::Vector3i> cells;
   std::vector<int> point_cell(points.size(), -1);
+  uint64_t previous_key = 0;  // Consecutive points often share a cell: no lookup then.
+  int previous_id = -1;
   for (size_t i = 0; i < points.size(); ++i) {
     if (is_ground[i]) continue;
     const Eigen::Vector3i c = CellOf(points[i], inv);
-    const int id = cell_id.Insert(PackCell(c.x(), c.y(), c.z()), static_cast<int>(cells.size()));
+    const uint64_t key = PackCell(c.x(), c.y(), c.z());
+    if (previous_id >= 0 && key == previous_key) {
+      point_cell[i] = previous_id;
+      continue;
+    }
+    const int id = cell_id.Insert(key, static_cast<int>(cells.size()));
     if (id == static_cast<int>(cells.size())) cells.push_back(c);
     point_cell[i] = id;
+    previous_key = key;
+    previous_id = id;
   }
   // Connected components over the 26-neighbourhood of occupied cells.
   std::vector<int> parent(cells.size());
@@ -213,24 +223,26 @@ std::vector<uint8_t> SmallObjectMask(const std::vector<Eigen::Vector3d>& points,
     }
   }
   // Bounding box of every component.
+  std::vector<int> root(cells.size());
+  for (size_t a = 0; a < cells.size(); ++a) root[a] = Find(parent, static_cast<int>(a));
   std::vector<Eigen::Vector3d> lo(cells.size(), Eigen::Vector3d::Constant(1e300));
   std::vector<Eigen::Vector3d> hi(cells.size(), Eigen::Vector3d::Constant(-1e300));
   for (size_t i = 0; i < points.size(); ++i) {
     if (point_cell[i] < 0) continue;
-    const int r = Find(parent, point_cell[i]);
+    const int r = root[point_cell[i]];
     lo[r] = lo[r].cwiseMin(points[i]);
     hi[r] = hi[r].cwiseMax(points[i]);
   }
   std::vector<uint8_t> small(cells.size(), 0);
   for (size_t r = 0; r < cells.size(); ++r) {
-    if (Find(parent, static_cast<int>(r)) != static_cast<int>(r)) continue;
+    if (root[r] != static_cast<int>(r)) continue;
     const Eigen::Vector3d e = hi[r] - lo[r];
     small[r] = e.x() < options.small_object_horizontal && e.z() < options.small_object_horizontal &&
                e.y() < options.small_object_height;
     *clusters_removed += small[r];
   }
   for (size_t i = 0; i < points.size(); ++i) {
-    if (point_cell[i] >= 0 && small[Find(parent, point_cell[i])]) keep[i] = 0;
+    if (point_cell[i] >= 0 && small[root[point_cell[i]]]) keep[i] = 0;
   }
   return keep;
 }

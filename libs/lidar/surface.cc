@@ -43,9 +43,8 @@ void FitLocalPlane(const std::vector<Eigen::Vector3d>& points,
 void SurfaceOptions::Check() const {
   JVL_CHECK(normal_neighbors >= 3, "normal_neighbors must be >= 3, got " << normal_neighbors);
   JVL_CHECK(normal_radius > 0, "normal_radius must be > 0, got " << normal_radius);
-  JVL_CHECK(
-      min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
-      "min_normal_neighbors must be in [3, normal_neighbors], got " << min_normal_neighbors);
+  JVL_CHECK(min_normal_neighbors >= 3 && min_normal_neighbors <= normal_neighbors,
+            "min_normal_neighbors must be in [3, normal_neighbors], got " << min_normal_neighbors);
 }
 
 ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
@@ -77,7 +76,9 @@ ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
           if (!(e < nn.back())) continue;
           nn.pop_back();
         }
-        nn.insert(std::upper_bound(nn.begin(), nn.end(), e), e);
+        // Into place from the back (mostly few steps: the nearer cells come first).
+        nn.push_back(e);
+        for (size_t m = nn.size() - 1; m > 0 && e < nn[m - 1]; --m) std::swap(nn[m], nn[m - 1]);
       }
       if (nn.size() < static_cast<size_t>(options.min_normal_neighbors)) continue;
       FitLocalPlane(points, nn, i, &s);

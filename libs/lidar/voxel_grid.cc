@@ -1,6 +1,7 @@
 #include "lidar/voxel_grid.h"
 
 #include <algorithm>
+#include <array>
 #include <numeric>
 
 #include "core/check.h"
@@ -59,14 +60,46 @@ std::vector<size_t> VoxelDownsample(const std::vector<Eigen::Vector3d>& points, 
   thread_local CellMap seen;
   seen.Clear(points.size());
   kept.reserve(points.size() / 2);
+  // Consecutive points of a scan (neighbours along a ring) mostly share a voxel: a point in the
+  // previous point's voxel is not the first in it and needs no lookup.
+  uint64_t previous = 0;
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3i c = CellOf(points[i], inv);
+    const uint64_t key = PackCell(c.x(), c.y(), c.z());
+    if (i > 0 && key == previous) continue;
+    previous = key;
     const size_t before = seen.size();
-    seen.Insert(PackCell(c.x(), c.y(), c.z()), 0);
+    seen.Insert(key, 0);
     if (seen.size() > before) kept.push_back(i);
   }
   return kept;
 }
+
+namespace {
+
+// The 27 cell offsets around a cell, the cell itself first, then by the number of non-zero
+// coordinates (face, edge, corner neighbours), each group in (x, y, z) order.
+std::array<Eigen::Vector3i, 27> NeighbourOffsets() {
+  std::array<Eigen::Vector3i, 27> offsets;
+  int n = 0;
+  for (int nonzero = 0; nonzero <= 3; ++nonzero) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          if ((dx != 0) + (dy != 0) + (dz != 0) == nonzero) offsets[n++] = {dx, dy, dz};
+        }
+      }
+    }
+  }
+  return offsets;
+}
+
+const std::array<Eigen::Vector3i, 27>& Offsets() {
+  static const std::array<Eigen::Vector3i, 27> offsets = NeighbourOffsets();
+  return offsets;
+}
+
+}  // namespace
 
 PointGrid::PointGrid(const std::vector<Eigen::Vector3d>& points, double cell_size)
     : points_(points), cell_size_(cell_size), inv_cell_(1.0 / cell_size) {
@@ -94,15 +127,11 @@ PointGrid::PointGrid(const std::vector<Eigen::Vector3d>& points, double cell_siz
 template <typename Fn>
 void PointGrid::ForEachNear(const Eigen::Vector3d& q, Fn&& fn) const {
   const Eigen::Vector3i c = CellOf(q, inv_cell_);
-  for (int dx = -1; dx <= 1; ++dx) {
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dz = -1; dz <= 1; ++dz) {
-        const int cell = cells_.Find(PackCell(c.x() + dx, c.y() + dy, c.z() + dz));
-        if (cell < 0) continue;
-        for (int k = cell_begin_[cell]; k < cell_begin_[cell + 1]; ++k) {
-          if (!fn(order_[k])) return;
-        }
-      }
+  for (const Eigen::Vector3i& d : Offsets()) {
+    const int cell = cells_.Find(PackCell(c.x() + d.x(), c.y() + d.y(), c.z() + d.z()));
+    if (cell < 0) continue;
+    for (int k = cell_begin_[cell]; k < cell_begin_[cell + 1]; ++k) {
+      if (!fn(order_[k])) return;
     }
   }
 }
@@ -138,6 +167,7 @@ int PointGrid::CountWithin(const Eigen::Vector3d& q, double radius, int stop_at)
 void PointGrid::ForEachCell(
     int threads,
     const std::function<void(const std::vector<int>&, const std::vector<int>&)>& fn) const {
+  const std::array<Eigen::Vector3i, 27>& offsets = Offsets();
   constexpr int64_t kChunk = 64;
   const int64_t n = static_cast<int64_t>(cell_keys_.size());
   ParallelFor((n + kChunk - 1) / kChunk, threads, [&](int64_t chunk) {
@@ -147,15 +177,11 @@ void PointGrid::ForEachCell(
       // Decode the cell from one member (cheaper than unpacking the key).
       const Eigen::Vector3i cell = CellOf(points_[members.front()], inv_cell_);
       candidates.clear();
-      for (int dx = -1; dx <= 1; ++dx) {
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dz = -1; dz <= 1; ++dz) {
-            const int n = cells_.Find(PackCell(cell.x() + dx, cell.y() + dy, cell.z() + dz));
-            if (n < 0) continue;
-            candidates.insert(candidates.end(), order_.begin() + cell_begin_[n],
-                              order_.begin() + cell_begin_[n + 1]);
-          }
-        }
+      for (const Eigen::Vector3i& d : offsets) {
+        const int m = cells_.Find(PackCell(cell.x() + d.x(), cell.y() + d.y(), cell.z() + d.z()));
+        if (m < 0) continue;
+        candidates.insert(candidates.end(), order_.begin() + cell_begin_[m],
+                          order_.begin() + cell_begin_[m + 1]);
       }
       fn(members, candidates);
     }

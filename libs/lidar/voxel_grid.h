@@ -86,8 +86,11 @@ class PointGrid {
 
   // Batched queries: calls fn(members, candidates) once per occupied cell, where members are
   // the indices of the points in the cell and candidates those in the 27 cells around it
-  // (itself included), so that every point within cell_size of a member is a candidate.
-  // Cells are split over `threads` threads; fn must only write to per-member slots.
+  // (itself included), so that every point within cell_size of a member is a candidate. The
+  // candidates come cell by cell, the nearer cells first: the cell itself, the 6 sharing a face
+  // with it, the 12 sharing an edge, the 8 sharing a corner (a search that stops early or keeps
+  // the nearest stops or fills sooner). Cells are split over `threads` threads; fn must only
+  // write to per-member slots.
   void ForEachCell(int threads,
                    const std::function<void(const std::vector<int>& members,
                                             const std::vector<int>& candidates)>& fn) const;

@@ -55,10 +55,10 @@ void BM_VisualAssocSequence(benchmark::State& state) {
       assoc_ms.push_back(result.frames[i].ms);
     }
   }
-  state.counters["frame_ms_median"] = UpperMedian(frame_ms);
+  state.counters["frame_ms_median"] = jvl::UpperMedian(frame_ms);
   state.counters["frame_ms_max"] = *std::max_element(frame_ms.begin(), frame_ms.end());
-  state.counters["orb_ms_median"] = UpperMedian(orb_ms);
-  state.counters["assoc_ms_median"] = UpperMedian(assoc_ms);
+  state.counters["orb_ms_median"] = jvl::UpperMedian(orb_ms);
+  state.counters["assoc_ms_median"] = jvl::UpperMedian(assoc_ms);
   state.counters["frames"] = static_cast<double>(poses.size());
 }
 BENCHMARK(BM_VisualAssocSequence)->Unit(benchmark::kMillisecond)->Iterations(3);
