@@ -59,19 +59,29 @@ ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
   const double r2 = options.normal_radius * options.normal_radius;
   const size_t k = static_cast<size_t>(options.normal_neighbors);
   grid.ForEachCell(threads, [&](const std::vector<int>& members, const std::vector<int>& cand) {
-    // Candidate coordinates copied once per cell: the inner loop then streams through memory.
-    std::vector<Eigen::Vector3d> cp(cand.size());
-    for (size_t c = 0; c < cand.size(); ++c) cp[c] = points[cand[c]];
+    // Candidate coordinates copied once per cell, one array per axis: the distances of all
+    // candidates to a member are then computed in one vectorised pass (the same arithmetic as
+    // (q - p).squaredNorm(): (dx^2 + dy^2) + dz^2).
+    const size_t n = cand.size();
+    std::vector<double> xs(n), ys(n), zs(n), d2(n);
+    for (size_t c = 0; c < n; ++c) {
+      xs[c] = points[cand[c]].x();
+      ys[c] = points[cand[c]].y();
+      zs[c] = points[cand[c]].z();
+    }
     std::vector<std::pair<double, int>> nn;
     for (const int i : members) {
+      const double px = points[i].x(), py = points[i].y(), pz = points[i].z();
+      for (size_t c = 0; c < n; ++c) {
+        const double dx = xs[c] - px, dy = ys[c] - py, dz = zs[c] - pz;
+        d2[c] = dx * dx + dy * dy + dz * dz;
+      }
       // The k nearest within the radius, kept sorted by (distance, index) - a strict order, so
       // the set is deterministic - by insertion (k is small; cheaper than a partition).
       nn.clear();
-      const Eigen::Vector3d& p = points[i];
-      for (size_t c = 0; c < cp.size(); ++c) {
-        const double d2 = (cp[c] - p).squaredNorm();
-        if (d2 > r2) continue;
-        const std::pair<double, int> e(d2, cand[c]);
+      for (size_t c = 0; c < n; ++c) {
+        if (d2[c] > r2) continue;
+        const std::pair<double, int> e(d2[c], cand[c]);
         if (nn.size() == k) {
           if (!(e < nn.back())) continue;
           nn.pop_back();
