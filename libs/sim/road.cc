@@ -228,8 +228,10 @@ Scenario ParseScenario(const std::string& name) {
   if (name == "highway") return Scenario::kHighway;
   if (name == "straight") return Scenario::kStraight;
   if (name == "loop") return Scenario::kLoop;
-  JVL_THROW("unknown scenario '" << name
-                                 << "' (expected urban, suburban, highway, straight or loop)");
+  if (name == "figure8") return Scenario::kFigureEight;
+  JVL_THROW(
+      "unknown scenario '" << name
+                           << "' (expected urban, suburban, highway, straight, loop or figure8)");
 }
 
 std::string ToString(Scenario scenario) {
@@ -244,6 +246,8 @@ std::string ToString(Scenario scenario) {
       return "straight";
     case Scenario::kLoop:
       return "loop";
+    case Scenario::kFigureEight:
+      return "figure8";
   }
   return "?";
 }
@@ -269,7 +273,8 @@ std::vector<RoadPiece> ScenarioLap(Scenario scenario) {
     case Scenario::kStraight:
       return {Straight(1200, 20.5)};
     case Scenario::kLoop:
-      break;  // LoopRoute().
+    case Scenario::kFigureEight:
+      break;  // LoopRoute(), FigureEightRoute().
   }
   return {};
 }
@@ -308,11 +313,51 @@ std::vector<RoadPiece> LoopRoute(int laps) {
   return p;
 }
 
+// kFigureEight: two blocks meet at a crossing X, block A (W x H between centre lines) on one
+// side of both streets through X, block B (H x W) on the other. Street S leads (heading west)
+// to A's corner J opposite X on their common street; the vehicle passes J straight on, crosses
+// X straight on along B's side, drives round B counter-clockwise (three left corners) back to X,
+// crosses X at right angles to the first time along A's side and drives round A clockwise
+// (three right corners) back towards J: one eight. Later eights turn right at J (new on the
+// second) and drive the same pieces again (marked repeat); the last one turns left at J onto S
+// and drives it back. Every place of the blocks is revisited in the same direction laps - 1
+// times, S once in the opposite direction; X is a crossing of four streets, J a junction of
+// three. Corners of radius R.
+std::vector<RoadPiece> FigureEightRoute(int laps) {
+  constexpr double kS = 150, kW = 130, kH = 110, kR = 12;
+  const RoadPiece left = Turn(90, kR, 5.0), right = Turn(-90, kR, 5.0);
+  // One eight from J onwards but for the piece into X: B's side through X, round B, through X,
+  // round A up to the corner before J.
+  const std::vector<RoadPiece> eight = {Straight(kH - kR, 11.0),
+                                        left,
+                                        Straight(kW - 2 * kR, 10.5),
+                                        left,
+                                        Straight(kH - 2 * kR, 11.0),
+                                        left,
+                                        Straight(kW - kR, 10.5),
+                                        Straight(kH - kR, 11.0),
+                                        right,
+                                        Straight(kW - 2 * kR, 10.5),
+                                        right,
+                                        Straight(kH - 2 * kR, 11.0)};
+  std::vector<RoadPiece> p = {Straight(kS, 10.5), Straight(kW, 11.0)};
+  p.insert(p.end(), eight.begin(), eight.end());
+  for (int lap = 1; lap < laps; ++lap) {
+    p.push_back(lap == 1 ? right : Repeat(right));  // Right at J: new on the second eight.
+    p.push_back(Repeat(Straight(kW - kR, 11.0)));   // J to X.
+    for (const RoadPiece& piece : eight) p.push_back(Repeat(piece));
+  }
+  p.push_back(left);  // Left at J, back onto S.
+  p.push_back(Repeat(Straight(kS - kR, 10.5)));
+  return p;
+}
+
 }  // namespace
 
 std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps) {
   JVL_CHECK(laps >= 1 && laps <= 100, "laps must be in [1, 100], got " << laps);
   if (scenario == Scenario::kLoop) return LoopRoute(laps);
+  if (scenario == Scenario::kFigureEight) return FigureEightRoute(laps);
   std::vector<RoadPiece> pieces;
   for (int lap = 0; lap < laps; ++lap) {
     for (RoadPiece p : ScenarioLap(scenario)) {

@@ -104,16 +104,21 @@ struct Terrain {
 // made for: one road direction over the whole drive). kLoop: the urban scenery around a city
 // block with revisits: a 150 m street to the block, `laps` circuits of it (130 m x 110 m, four
 // left corners, 459 m each; every place revisited in the same direction) and back along the
-// street (revisited in the opposite direction).
-enum class Scenario { kUrban, kSuburban, kHighway, kStraight, kLoop };
-Scenario ParseScenario(const std::string& name);  // urban|suburban|highway|straight|loop
+// street (revisited in the opposite direction). kFigureEight: the urban scenery along a figure
+// eight of two blocks that meet at a crossing X (see FigureEightRoute in road.cc): a 150 m
+// street to the first block's corner J, `laps` eights (every place of the blocks revisited in the
+// same direction, X crossed in two directions at right angles) and back along the street.
+enum class Scenario { kUrban, kSuburban, kHighway, kStraight, kLoop, kFigureEight };
+// urban|suburban|highway|straight|loop|figure8
+Scenario ParseScenario(const std::string& name);
 std::string ToString(Scenario scenario);
 // Highway and straight: fast, open scenery (few buildings far from the road, no kerbside
 // furniture, flatter terrain).
 bool IsHighwayLike(Scenario scenario);
 // `laps` > 1 repeats the pieces; every second lap has its turns mirrored (left <-> right), so
 // that the route zigzags on without crossing itself (urban: 9 laps = 4.3 km, 4779 frames). For
-// kLoop, `laps` is the number of circuits of the block (pieces after the first marked repeat).
+// kLoop, `laps` is the number of circuits of the block, for kFigureEight the number of eights
+// (pieces driven before marked repeat).
 std::vector<RoadPiece> ScenarioRoute(Scenario scenario, int laps = 1);
 // `pieces` with a straight lead piece of `length` metres before the first and after the last
 // one (none when length is 0): the road and its world continue straight beyond the ends of the

@@ -140,6 +140,55 @@ TEST(RouteTest, LoopRevisitsTheBlockAndTheStreet) {
       EXPECT_GT((scene.plants[i].center - scene.plants[j].center).norm(), 1.0);
 }
 
+// The figure-eight scenario: a street, three eights round two blocks and back. Every repeated
+// piece lies on the geometry laid out before it, the drive ends where it started, the route
+// crosses itself at X (once per eight heading west, once heading north: at right angles), and
+// a third eight adds no world; the world stays clear of every street, the crossing's included.
+TEST(RouteTest, FigureEightCrossesItselfAndRevisitsBothBlocks) {
+  EXPECT_EQ(ParseScenario("figure8"), Scenario::kFigureEight);
+  EXPECT_EQ(ToString(Scenario::kFigureEight), "figure8");
+  const Route route(ScenarioRoute(Scenario::kFigureEight, 3), Eigen::Vector2d(5, -3), 0.35);
+  const double R = 12, arc = M_PI / 2 * R;
+  // Round B (four sides, three corners) and round A from X to the corner before J (three
+  // sides, two corners), then J to X: straight on (130 m) on the first eight, a right corner
+  // and 118 m on the others.
+  const double b = 2 * (110 + 130) - 6 * R + 3 * arc, a = 2 * 110 + 130 - 5 * R + 2 * arc;
+  EXPECT_NEAR(route.length(), 150 + (130 + b + a) + 2 * (arc + 130 - R + b + a) + arc + 150 - R,
+              1e-6);
+  EXPECT_LT((route.At(route.length()).position - Eigen::Vector2d(5, -3)).norm(), 1e-9);
+  double repeated = 0;
+  for (const RoadPiece& piece : route.pieces()) {
+    if (!piece.repeat) continue;
+    repeated += piece.length;
+    for (double t = 0; t <= piece.length; t += piece.length / 20)
+      EXPECT_LT(route.Distance(route.At(piece.s0 + t).position), 1e-6) << "piece at " << piece.s0;
+  }
+  // Revisited: eights 2 and 3 but for the new right corner at J, and the street back.
+  EXPECT_NEAR(repeated, 2 * (arc + 130 - R + b + a) - arc + 150 - R, 1e-6);
+  // X: 280 m (the street and J-X) into the drive, in the start heading; again after B's
+  // circuit (three left corners), a quarter turn to the right of it.
+  const RoadPoint west = route.At(150 + 130), north = route.At(150 + 130 + b);
+  EXPECT_LT((west.position - north.position).norm(), 1e-6);
+  EXPECT_NEAR(std::remainder(north.heading - west.heading, 2 * M_PI), -M_PI / 2, 1e-9);
+  SequenceOptions opt;
+  opt.scenario = Scenario::kFigureEight;
+  opt.laps = 3;
+  opt.render_images = opt.simulate_scans = false;
+  const auto three = BuildWorld(opt);
+  opt.laps = 2;
+  const auto two = BuildWorld(opt);
+  const Scene& scene = three->scene;
+  ASSERT_EQ(two->scene.buildings.size(), scene.buildings.size());
+  for (size_t i = 0; i < scene.buildings.size(); ++i)
+    EXPECT_EQ(two->scene.buildings[i].center, scene.buildings[i].center);
+  ASSERT_EQ(two->scene.plants.size(), scene.plants.size());
+  ASSERT_GT(scene.buildings.size(), 30u);
+  for (const Building& bd : scene.buildings)
+    for (const auto& c : bd.Corners())
+      EXPECT_GT(scene.route.Distance(c),
+                scene.options.road_half_width + scene.options.sidewalk_width - 0.3);
+}
+
 TEST(DriveTest, DefaultDemoMeetsTheBrief) {
   SequenceOptions opt;
   const auto world = BuildWorld(opt);

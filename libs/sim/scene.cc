@@ -76,6 +76,7 @@ BuildingStyle StyleFor(Scenario s) {
   switch (s) {
     case Scenario::kUrban:
     case Scenario::kLoop:
+    case Scenario::kFigureEight:
       return {12, 30, 10, 16, 1.0, 0.35, 4, 12, 3, 6, 0.0};
     case Scenario::kSuburban:
       return {8, 14, 8, 12, 3.0, 0.85, 6, 16, 1, 2, 3.0};
@@ -194,8 +195,9 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
 
 void PlacePlants(Scene& scene, Rng& rng) {
   const double hw = scene.options.road_half_width;
-  const bool green =
-      scene.options.scenario != Scenario::kUrban && scene.options.scenario != Scenario::kLoop;
+  const bool green = scene.options.scenario != Scenario::kUrban &&
+                     scene.options.scenario != Scenario::kLoop &&
+                     scene.options.scenario != Scenario::kFigureEight;
   for (const RoadPiece& piece : scene.route.pieces()) {
     if (piece.repeat) continue;
     const double spacing = piece.open ? 7.0 : (green ? 14.0 : 30.0);

@@ -8,7 +8,7 @@ void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
   app::OptionGroup route(tool, "Route");
   route.Add("--laps", "laps", o->laps,
             "Drive the route this many times, every second lap mirrored (long sequences); "
-            "with --scenario loop: circuits of the block");
+            "with --scenario loop: circuits of the block; with figure8: figure eights");
   route.Add("--seed", o->seed, "Random seed (world layout and noise)");
   route.Add("--road-beyond", "road_beyond", o->road_beyond,
             "The road and the world along it continue this far (m) straight beyond both ends "

@@ -41,7 +41,8 @@ int main(int argc, char** argv) {
   cli.add_option("--scenario", scenario,
                  "urban, suburban, highway, straight (highway scenery, one 1.2 km straight) or "
                  "loop (urban scenery: a street, --laps circuits of a city block, back along "
-                 "the street)")
+                 "the street) or figure8 (urban scenery: a street, --laps figure eights round "
+                 "two blocks that meet at a crossing, back along the street)")
       ->capture_default_str();
   jvl::tools::AddSimSequenceFlags(tool, &opt);
   tool.FieldFlag("frames", "--frames");
