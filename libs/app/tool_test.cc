@@ -1,7 +1,6 @@
 #include "app/tool.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <thread>
@@ -9,6 +8,7 @@
 
 #include "app/option_group.h"
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/files.h"
 #include "io/trajectory_io.h"
 
@@ -51,9 +51,8 @@ TEST(ToolTest, ErrorsBecomeExitCodes) {
 }
 
 TEST(ToolTest, InputsOfDifferentSequencesAreRejected) {
-  const std::string dir =
-      (std::filesystem::temp_directory_path() / ("jvl_tool_" + std::to_string(::getpid())))
-          .string();
+  const TempDir tmp("jvl_tool");
+  const std::string dir = tmp.path().string();
   Trajectory t;
   t.Append(0, Rigid3d());
   io::Provenance p;
@@ -102,7 +101,8 @@ std::pair<int, bool> RunWithPaths(const std::vector<std::string>& args) {
 
 TEST(ToolTest, OutputsThatAreInputsAreRefusedBeforeTheBody) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / ("jvl_tool_out_" + std::to_string(::getpid()));
+  const TempDir tmp("jvl_tool_out");
+  const fs::path dir = tmp.path();
   fs::create_directories(dir / "sub");
   const std::string in = (dir / "in.txt").string();
   io::WriteTextFileAtomic(in, "input\n");
@@ -135,9 +135,8 @@ TEST(ToolTest, OutputsThatAreInputsAreRefusedBeforeTheBody) {
 
 TEST(ToolTest, ConfigKeysUnsignedValuesAndThreadCountsAreChecked) {
   namespace fs = std::filesystem;
-  const std::string config =
-      (fs::temp_directory_path() / ("jvl_tool_cfg_" + std::to_string(::getpid()) + ".ini"))
-          .string();
+  const TempDir tmp("jvl_tool_cfg");
+  const std::string config = tmp.Path("config.ini");
   io::WriteTextFileAtomic(config, "weight = 2\nno_such_key = 3\n");
   {
     Tool tool("demo", "d");
@@ -177,8 +176,9 @@ TEST(ToolTest, ErrorsNameFlagsInsteadOfFields) {
   const char* argv[] = {"demo"};
   EXPECT_EQ(tool.Run(1, argv,
                      [] {
-                       JVL_THROW("samples_per_list must be >= 1 (kernel_h 0.3, max_distance "
-                                 "0.5, frames 2)");
+                       JVL_THROW(
+                           "samples_per_list must be >= 1 (kernel_h 0.3, max_distance "
+                           "0.5, frames 2)");
                      }),
             1);
   const std::string err = testing::internal::GetCapturedStderr();

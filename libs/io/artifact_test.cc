@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/files.h"
 #include "io/local_io.h"
 #include "io/schema_check.h"
@@ -22,12 +23,7 @@ const std::string kSchemas = std::string(JVL_SOURCE_DIR) + "/schemas";
 
 class ArtifactTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("jvl_artifact_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string Path(const std::string& name) const { return dir_.Path(name); }
   std::string ErrorOf(const std::function<void()>& fn) {
     try {
       fn();
@@ -38,10 +34,11 @@ class ArtifactTest : public ::testing::Test {
   }
   Trajectory Small() const {
     Trajectory t;
-    for (int i = 0; i < 5; ++i) t.Append(i, Rigid3d(Eigen::Quaterniond::Identity(), {0, 0, 1.0 * i}));
+    for (int i = 0; i < 5; ++i)
+      t.Append(i, Rigid3d(Eigen::Quaterniond::Identity(), {0, 0, 1.0 * i}));
     return t;
   }
-  fs::path dir_;
+  TempDir dir_{"jvl_artifact"};
 };
 
 TEST_F(ArtifactTest, ArraysAttributesAndProvenanceRoundTrip) {
@@ -70,8 +67,7 @@ TEST_F(ArtifactTest, ArraysAttributesAndProvenanceRoundTrip) {
   EXPECT_EQ(r.provenance()["inputs"][0]["size"], 12);
   EXPECT_FALSE(r.Has("nope"));
   EXPECT_FALSE(r.Has("group/nope/deeper"));
-  EXPECT_EQ(r.ListDatasets(),
-            (std::vector<std::string>{"bytes", "empty", "group/sub/values"}));
+  EXPECT_EQ(r.ListDatasets(), (std::vector<std::string>{"bytes", "empty", "group/sub/values"}));
   EXPECT_EQ(r.ListAttributes(), (std::vector<std::string>{"group/note", "meta", "provenance",
                                                           "schema", "schema_version"}));
   EXPECT_THROW(r.ReadArray<double>("group/sub/values", 4), Error);
@@ -81,7 +77,8 @@ TEST_F(ArtifactTest, SchemaMismatchNamesFileExpectedAndFound) {
   WriteTrajectoryArtifact(Path("t.h5"), Small(), Provenance{});
   const std::string msg = ErrorOf([&] { H5Reader(Path("t.h5"), "vps", 1); });
   EXPECT_NE(msg.find("t.h5: expected schema 'vps' version 1, found 'trajectory' version 1"),
-            std::string::npos) << msg;
+            std::string::npos)
+      << msg;
   EXPECT_NE(ErrorOf([&] { H5Reader(Path("t.h5"), "trajectory", 2); }).find("version 2"),
             std::string::npos);
 }
@@ -131,7 +128,7 @@ TEST_F(ArtifactTest, UncommittedWriterLeavesPreviousArtifactIntact) {
     // Destroyed without Commit(), as when an exception unwinds a tool.
   }
   EXPECT_EQ(ReadTextFile(Path("t.h5")), before);
-  for (const auto& entry : fs::directory_iterator(dir_))
+  for (const auto& entry : fs::directory_iterator(dir_.path()))
     EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
 }
 
@@ -151,7 +148,7 @@ TEST_F(ArtifactTest, AtomicWriteNamesWhyTheRenameFailed) {
   const std::string message = ErrorOf([&] { WriteTextFileAtomic(Path("taken"), "new"); });
   EXPECT_NE(message.find("cannot move the finished file into place"), std::string::npos);
   EXPECT_EQ(message.find("Success"), std::string::npos) << message;
-  for (const auto& entry : fs::directory_iterator(dir_))
+  for (const auto& entry : fs::directory_iterator(dir_.path()))
     EXPECT_EQ(entry.path().string().find(".tmp."), std::string::npos) << entry.path();
 }
 
@@ -186,13 +183,14 @@ TEST_F(ArtifactTest, JsonArtifactRoundTripAndSchemaCheck) {
   WriteJsonArtifact(Path("m.json"), "metrics", 1, {{"value", 2.5}}, p);
   const auto j = ReadJsonArtifact(Path("m.json"), "metrics", 1);
   EXPECT_EQ(j["value"], 2.5);
-  EXPECT_TRUE(CheckJsonAgainstSchema(j["provenance"], kSchemas + "/provenance.schema.json").empty());
+  EXPECT_TRUE(
+      CheckJsonAgainstSchema(j["provenance"], kSchemas + "/provenance.schema.json").empty());
   EXPECT_NE(ErrorOf([&] { ReadJsonArtifact(Path("m.json"), "vps", 1); }).find("found 'metrics'"),
             std::string::npos);
   std::ofstream(Path("broken.json")) << "{\"schema\": ";
-  EXPECT_NE(ErrorOf([&] { ReadJsonArtifact(Path("broken.json"), "metrics", 1); })
-                .find("not valid JSON"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf([&] { ReadJsonArtifact(Path("broken.json"), "metrics", 1); }).find("not valid JSON"),
+      std::string::npos);
 }
 
 TEST_F(ArtifactTest, TrajectoryArtifactMatchesItsSchema) {

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/files.h"
 #include "io/kitti.h"
 
@@ -81,7 +82,7 @@ TEST(KittiOdometryTest, FrameRangeSelection) {
 class BadDatasetTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ = fs::temp_directory_path() / ("jvl_bad_ds_" + std::to_string(::getpid()));
+    root_ = tmp_.path();
     seq_ = root_ / "sequences" / "07";
     fs::create_directories(seq_ / "velodyne");
     Calibration calib;
@@ -99,7 +100,6 @@ class BadDatasetTest : public ::testing::Test {
     cloud.intensity = {0.5f, 0.25f};
     for (int f = 0; f < 3; ++f) WriteVelodyneBin(Scan(f), cloud);
   }
-  void TearDown() override { fs::remove_all(root_); }
   std::string Scan(int f) const {
     char name[16];
     std::snprintf(name, sizeof(name), "%06d.bin", f);
@@ -113,6 +113,7 @@ class BadDatasetTest : public ::testing::Test {
     }
     return "<no error>";
   }
+  TempDir tmp_{"jvl_bad_ds"};
   fs::path root_, seq_;
 };
 
@@ -152,8 +153,9 @@ TEST_F(BadDatasetTest, ColourCameraImagesAreReadAsGrey) {
   EXPECT_NE(ErrorOf([&] { ds->CheckCamera(5); }).find("--camera 5 is not a camera"),
             std::string::npos);
   // A camera without images is refused before any work, naming the first selected frame.
-  EXPECT_NE(ErrorOf([&] { ds->CheckCamera(0); })
-                .find("image_0/000000.png: missing image of camera 0 for frame 0"),
+  EXPECT_NE(ErrorOf([&] {
+              ds->CheckCamera(0);
+            }).find("image_0/000000.png: missing image of camera 0 for frame 0"),
             std::string::npos);
 }
 

@@ -1,14 +1,14 @@
 #include "io/directions_io.h"
-#include "io/vps_io.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/schema_check.h"
+#include "io/vps_io.h"
 
 namespace jvl::io {
 namespace {
@@ -17,12 +17,7 @@ namespace fs = std::filesystem;
 
 class DirectionsIoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("jvl_directions_io_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string Path(const std::string& name) const { return dir_.Path(name); }
   static DirectionsData Sample() {
     DirectionsData d;
     d.clusters.push_back({0, {0, 0, 1}, 0.4, 2, 3, 9, {0, 1.5, 6}});
@@ -33,7 +28,7 @@ class DirectionsIoTest : public ::testing::Test {
     d.summary = {{"associations", 3}};
     return d;
   }
-  fs::path dir_;
+  TempDir dir_{"jvl_directions_io"};
 };
 
 TEST_F(DirectionsIoTest, RoundTripMatchesSchemaAndCsv) {

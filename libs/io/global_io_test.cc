@@ -1,12 +1,12 @@
 #include "io/global_io.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/ply_io.h"
 #include "io/schema_check.h"
 
@@ -17,13 +17,8 @@ namespace fs = std::filesystem;
 
 class GlobalIoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("jvl_global_io_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  std::string Path(const std::string& name) const { return dir_.Path(name); }
+  TempDir dir_{"jvl_global_io"};
 };
 
 GlobalData Sample() {

@@ -1,7 +1,6 @@
 #include "io/kitti360.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/kitti.h"
 
 namespace jvl::io {
@@ -40,7 +40,7 @@ Rigid3d Yaw(double yaw, const Eigen::Vector3d& t) {
 class Kitti360Test : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ = fs::temp_directory_path() / ("jvl_k360_" + std::to_string(::getpid()));
+    root_ = tmp_.path();
     velo_ = root_ / "data_3d_raw" / kDrive;
     images_ = root_ / "data_2d_raw" / kDrive;
     poses_ = root_ / "data_poses" / kDrive;
@@ -103,7 +103,6 @@ class Kitti360Test : public ::testing::Test {
       cam << "\n";
     }
   }
-  void TearDown() override { fs::remove_all(root_); }
 
   // The expected ground truth: rectified camera 0, relative to frame 1 (the first posed one).
   Rigid3d Expected(int frame) const {
@@ -112,6 +111,7 @@ class Kitti360Test : public ::testing::Test {
     return first.Inverse() * world_from_rect;
   }
 
+  TempDir tmp_{"jvl_k360"};
   fs::path root_, velo_, images_, poses_;
   Rigid3d rect_, velo_from_cam_, pose_from_cam_;
   std::map<int, Rigid3d> world_from_imu_;

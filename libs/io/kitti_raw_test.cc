@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/kitti.h"
 
 namespace jvl::io {
@@ -34,7 +35,7 @@ double LongitudeAt(double dx) {
 class KittiRawTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    date_ = fs::temp_directory_path() / ("jvl_raw_" + std::to_string(::getpid())) / "2011_09_26";
+    date_ = tmp_.path() / "2011_09_26";
     drive_ = date_ / "2011_09_26_drive_0001_sync";
     for (const char* sub : {"velodyne_points/data", "oxts/data", "image_00/data"})
       fs::create_directories(drive_ / sub);
@@ -69,15 +70,15 @@ class KittiRawTest : public ::testing::Test {
       oxts << "\n";
       PointCloud cloud;
       cloud.points = {{10, 0, 0}};
-      WriteVelodyneBin((drive_ / "velodyne_points" / "data" / (std::string(name) + ".bin")).string(),
-                       cloud);
+      WriteVelodyneBin(
+          (drive_ / "velodyne_points" / "data" / (std::string(name) + ".bin")).string(), cloud);
       char stamp[64];
       std::snprintf(stamp, sizeof(stamp), "2011-09-26 13:02:%02zu.%09d", 25 + i / 10,
                     static_cast<int>((i % 10) * 100000000 + 12345));
       stamps << stamp << "\n";
     }
   }
-  void TearDown() override { fs::remove_all(date_.parent_path()); }
+  TempDir tmp_{"jvl_raw"};
   fs::path date_, drive_;
 };
 

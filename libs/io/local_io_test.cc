@@ -1,11 +1,11 @@
 #include "io/local_io.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/schema_check.h"
 
 namespace jvl::io {
@@ -41,8 +41,8 @@ LocalMapData MakeLocal() {
 }
 
 std::string TempPath(const std::string& name) {
-  return (fs::temp_directory_path() / ("jvl_local_io_test_" + std::to_string(::getpid()) + name))
-      .string();
+  static const TempDir dir("jvl_local_io_test");
+  return dir.Path(name);
 }
 
 TEST(LocalIo, RoundTripAndSchema) {

@@ -4,13 +4,15 @@
 
 #include <filesystem>
 
+#include "core/temp_dir.h"
 #include "io/schema_check.h"
 
 namespace jvl::io {
 namespace {
 
 std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("jvl_loops_io_" + name)).string();
+  static const TempDir dir("jvl_loops_io");
+  return dir.Path(name);
 }
 
 LoopsData Sample() {

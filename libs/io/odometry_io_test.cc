@@ -1,13 +1,13 @@
 #include "io/odometry_io.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/schema_check.h"
 #include "io/trajectory_io.h"
 
@@ -37,7 +37,8 @@ OdometryArtifact MakeArtifact(int n) {
 }
 
 std::string TempPath(const std::string& name) {
-  return (fs::temp_directory_path() / (name + std::to_string(::getpid()) + ".h5")).string();
+  static const TempDir dir("jvl_odometry_io");
+  return dir.Path(name + ".h5");
 }
 
 TEST(OdometryIoTest, RoundTripAndTrajectoryReader) {

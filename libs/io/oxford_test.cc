@@ -1,7 +1,6 @@
 #include "io/oxford.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstring>
@@ -11,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/files.h"
 
 namespace jvl::io {
@@ -34,7 +34,7 @@ void WriteBytes(const fs::path& path, const void* data, size_t size) {
 class OxfordTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    sdk_ = fs::temp_directory_path() / ("jvl_oxford_" + std::to_string(::getpid()));
+    sdk_ = tmp_.path();
     dir_ = sdk_ / "2019-01-10-14-36-48-radar-oxford-10k";
     for (const fs::path& d : {dir_ / "stereo" / "centre", dir_ / "velodyne_left", dir_ / "gps",
                               sdk_ / "extrinsics", sdk_ / "models"})
@@ -78,7 +78,7 @@ class OxfordTest : public ::testing::Test {
           << 5735000.0 + 1.0 * j << ",620000.0,-100.0,30U,10,0,0,0,0,0\n";
     }
   }
-  void TearDown() override { fs::remove_all(sdk_); }
+  TempDir tmp_{"jvl_oxford"};
   fs::path sdk_, dir_;
 };
 

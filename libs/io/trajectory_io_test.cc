@@ -7,6 +7,7 @@
 
 #include "core/check.h"
 #include "core/strings.h"
+#include "core/temp_dir.h"
 #include "io/files.h"
 
 namespace jvl::io {
@@ -34,13 +35,8 @@ void ExpectSame(const Trajectory& a, const Trajectory& b, double tol) {
 
 class TrajectoryIoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("jvl_traj_test_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
+  std::string Path(const std::string& name) const { return dir_.Path(name); }
+  TempDir dir_{"jvl_traj_test"};
 };
 
 TEST_F(TrajectoryIoTest, KittiRoundTripIsExact) {

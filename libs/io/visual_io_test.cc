@@ -1,13 +1,13 @@
 #include "io/visual_io.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/schema_check.h"
 
 namespace jvl::io {
@@ -49,7 +49,8 @@ VisualMapData MakeMap() {
 }
 
 fs::path TempPath(const std::string& name) {
-  return fs::temp_directory_path() / ("jvl_visual_io_test_" + std::to_string(::getpid()) + name);
+  static const TempDir dir("jvl_visual_io_test");
+  return dir.path() / name;
 }
 
 TEST(VisualIo, RoundTrip) {

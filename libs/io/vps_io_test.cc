@@ -9,6 +9,7 @@
 #include <map>
 
 #include "core/check.h"
+#include "core/temp_dir.h"
 #include "io/files.h"
 
 namespace jvl::io {
@@ -39,7 +40,8 @@ VpsData Sample() {
 }
 
 std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("jvl_vps_io_" + name)).string();
+  static const TempDir dir("jvl_vps_io");
+  return dir.Path(name);
 }
 
 TEST(VpsIo, RoundTrip) {

@@ -1,12 +1,12 @@
 #include "loop/vocabulary.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "core/temp_dir.h"
 #include "io/artifact.h"
 #include "io/schema_check.h"
 
@@ -141,8 +141,8 @@ TEST(Vocabulary, SavesAndLoadsTheSameTree) {
   o.branching = 5;
   o.depth = 2;
   const Vocabulary v = Vocabulary::Train(images, o, 1);
-  const std::filesystem::path path = std::filesystem::temp_directory_path() /
-                                     ("jvl_vocabulary_" + std::to_string(getpid()) + ".h5");
+  const TempDir tmp("jvl_vocabulary");
+  const std::filesystem::path path = tmp.path() / "vocabulary.h5";
   v.Save(path.string(), io::Provenance{});
   const Vocabulary w = Vocabulary::Load(path.string());
   EXPECT_EQ(w.num_words(), v.num_words());

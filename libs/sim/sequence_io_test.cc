@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/temp_dir.h"
 #include "io/dataset.h"
 #include "io/sim_io.h"
 #include "sim/write_sequence.h"
@@ -21,8 +22,10 @@ std::string Slurp(const fs::path& p) {
   return os.str();
 }
 
-fs::path TempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("jvl_sim_test_" + name);
+// A path that does not exist yet, in a directory of this process's own.
+fs::path ScratchPath(const std::string& name) {
+  static const jvl::TempDir dir("jvl_sim_test");
+  const fs::path d = dir.path() / name;
   fs::remove_all(d);
   return d;
 }
@@ -41,7 +44,7 @@ SequenceOptions Small(uint64_t seed) {
 }
 
 TEST(SequenceIoTest, SameSeedGivesByteIdenticalFiles) {
-  const fs::path a = TempDir("a"), b = TempDir("b"), c = TempDir("c");
+  const fs::path a = ScratchPath("a"), b = ScratchPath("b"), c = ScratchPath("c");
   WriteSequence(*BuildWorld(Small(5)), io::SequenceLayout{a.string(), "00"}, 1, TestProvenance);
   WriteSequence(*BuildWorld(Small(5)), io::SequenceLayout{b.string(), "00"}, 2, TestProvenance);
   WriteSequence(*BuildWorld(Small(6)), io::SequenceLayout{c.string(), "00"}, 2, TestProvenance);
@@ -70,7 +73,7 @@ TEST(SequenceIoTest, SameSeedGivesByteIdenticalFiles) {
 }
 
 TEST(SequenceIoTest, Kitti360LayoutReadsBackLikeTheKittiOne) {
-  const fs::path root = TempDir("read360");
+  const fs::path root = ScratchPath("read360");
   const auto world = BuildWorld(Small(2));
   const io::SequenceLayout layout{root.string(), "07", io::SimLayout::kKitti360};
   WriteSequence(*world, layout, 2, TestProvenance);
@@ -102,7 +105,7 @@ TEST(SequenceIoTest, Kitti360LayoutReadsBackLikeTheKittiOne) {
 }
 
 TEST(SequenceIoTest, KittiReaderReadsItBack) {
-  const fs::path root = TempDir("read");
+  const fs::path root = ScratchPath("read");
   const auto world = BuildWorld(Small(2));
   WriteSequence(*world, io::SequenceLayout{root.string(), "07"}, 2, TestProvenance);
   const auto ds = io::OpenDataset((root / "sequences" / "07").string());
@@ -161,7 +164,7 @@ void CheckRequired(const nlohmann::json& schema, const nlohmann::json& value,
 }
 
 TEST(SequenceIoTest, OutputsMatchTheirSchemas) {
-  const fs::path root = TempDir("schema");
+  const fs::path root = ScratchPath("schema");
   WriteSequence(*BuildWorld(Small(3)), io::SequenceLayout{root.string(), "00"}, 2, TestProvenance);
   for (const std::string name : {"sim_vps", "sim_scene"}) {
     const auto schema = nlohmann::json::parse(

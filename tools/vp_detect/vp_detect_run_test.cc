@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 
+#include "core/temp_dir.h"
 #include "io/files.h"
 #include "io/vps_io.h"
 
@@ -37,9 +38,8 @@ TEST(VpDetectRun, ThreadsDoNotChangeTheResultAndOverlaysAreWritten) {
   options.threads = 1;
   const VpDetectRunResult one = RunVpDetect(*dataset, options);
   options.threads = 2;
-  const std::string debug =
-      (std::filesystem::temp_directory_path() / "jvl_vp_detect_debug").string();
-  std::filesystem::remove_all(debug);
+  const TempDir tmp("jvl_vp_detect_debug");
+  const std::string debug = tmp.Path("debug");
   options.debug_dir = debug;
   const VpDetectRunResult two = RunVpDetect(*dataset, options);
   ExpectSameRecords(one.data, two.data);
@@ -63,8 +63,8 @@ TEST(VpDetectRun, CommandLineWritesArtifactAndCsv) {
   const std::string exe = std::string(JVL_BINARY_DIR) + "/bin/vp_detect";
   if (!HaveData()) GTEST_SKIP() << "KITTI 04 subset not found at " << kSeq;
   if (!io::FileExists(exe)) GTEST_SKIP() << exe << " not built";
-  const auto tmp = std::filesystem::temp_directory_path();
-  const std::string out = (tmp / "jvl_vp_cli.h5").string(), csv = (tmp / "jvl_vp_cli.csv").string();
+  const TempDir tmp("jvl_vp_cli");
+  const std::string out = tmp.Path("vps.h5"), csv = tmp.Path("vps.csv");
   const std::string cmd = exe + " --dataset " + kSeq + " --frames 0:3 -o " + out + " --csv " + csv +
                           " --quiet --log-level warn";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/temp_dir.h"
 #include "core/timer.h"
 #include "io/dataset.h"
 #include "io/local_io.h"
@@ -66,7 +67,8 @@ KittiLocalRun RunKittiLocal(const io::Dataset& dataset, const Trajectory& prior,
       input,
       [&](size_t row) {
         return PrepareKeyframeScan(dataset.LoadScan(input.frames[row]), cam0_from_velo,
-                                   ScanOptions(), LocalMappingOptions().association.samples_per_list, 2);
+                                   ScanOptions(),
+                                   LocalMappingOptions().association.samples_per_list, 2);
       },
       options, 2);
   std::vector<Rigid3d> truth;
@@ -96,7 +98,8 @@ TEST(KittiLocal, LidarOdometryPriorIsNotMadeWorse) {
   for (const auto& s : run.result.stats) optimized += s.optimized;
   EXPECT_GE(optimized, run.keyframes - 1);
   // The artifact of a real run matches its schema and reads back.
-  const std::string path = (fs::temp_directory_path() / "jvl_local_kitti_test.h5").string();
+  const TempDir tmp("jvl_local_kitti_test");
+  const std::string path = tmp.Path("local.h5");
   const LocalMappingOptions options;
   io::WriteLocalMap(
       path, ExportLocalMap(run.input, run.result, prior, SummarizeLocalMap(run.result, options)),

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 
+#include "core/temp_dir.h"
 #include "io/dataset.h"
 #include "io/trajectory_io.h"
 #include "io/visual_io.h"
@@ -60,7 +61,8 @@ TEST(KittiVisual, GroundTruthPriorGivesDenseAccurateMap) {
     ASSERT_LT(z, 1000.0);
   }
   // Round trip through the artifact.
-  const std::string path = (fs::temp_directory_path() / "jvl_kitti_visual_test.h5").string();
+  const TempDir tmp("jvl_kitti_visual_test");
+  const std::string path = tmp.Path("visual.h5");
   io::WriteVisualMap(path, run.data, io::Provenance{});
   const io::VisualMapData back = io::ReadVisualMap(path);
   EXPECT_EQ(back.num_mappoints(), run.data.num_mappoints());
