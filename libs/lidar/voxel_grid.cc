@@ -79,23 +79,21 @@ namespace {
 
 // The 27 cell offsets around a cell, the cell itself first, then by the number of non-zero
 // coordinates (face, edge, corner neighbours), each group in (x, y, z) order.
-std::array<Eigen::Vector3i, 27> NeighbourOffsets() {
-  std::array<Eigen::Vector3i, 27> offsets;
-  int n = 0;
-  for (int nonzero = 0; nonzero <= 3; ++nonzero) {
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dz = -1; dz <= 1; ++dz) {
-          if ((dx != 0) + (dy != 0) + (dz != 0) == nonzero) offsets[n++] = {dx, dy, dz};
+const std::array<Eigen::Vector3i, 27>& Offsets() {
+  static const std::array<Eigen::Vector3i, 27> offsets = [] {
+    std::array<Eigen::Vector3i, 27> o;
+    int n = 0;
+    for (int nonzero = 0; nonzero <= 3; ++nonzero) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dz = -1; dz <= 1; ++dz) {
+            if ((dx != 0) + (dy != 0) + (dz != 0) == nonzero) o[n++] = {dx, dy, dz};
+          }
         }
       }
     }
-  }
-  return offsets;
-}
-
-const std::array<Eigen::Vector3i, 27>& Offsets() {
-  static const std::array<Eigen::Vector3i, 27> offsets = NeighbourOffsets();
+    return o;
+  }();
   return offsets;
 }
 
