@@ -252,6 +252,11 @@ std::string ToString(Scenario scenario) {
   return "?";
 }
 
+bool IsUrbanLike(Scenario scenario) {
+  return scenario == Scenario::kUrban || scenario == Scenario::kLoop ||
+         scenario == Scenario::kFigureEight;
+}
+
 bool IsHighwayLike(Scenario scenario) {
   return scenario == Scenario::kHighway || scenario == Scenario::kStraight;
 }

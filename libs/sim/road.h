@@ -115,6 +115,8 @@ std::string ToString(Scenario scenario);
 // Highway and straight: fast, open scenery (few buildings far from the road, no kerbside
 // furniture, flatter terrain).
 bool IsHighwayLike(Scenario scenario);
+// Urban, loop and figure eight: the city scenery (dense buildings, few plants).
+bool IsUrbanLike(Scenario scenario);
 // `laps` > 1 repeats the pieces; every second lap has its turns mirrored (left <-> right), so
 // that the route zigzags on without crossing itself (urban: 9 laps = 4.3 km, 4779 frames). For
 // kLoop, `laps` is the number of circuits of the block, for kFigureEight the number of eights

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "sim/describe.h"
 #include "sim/prior.h"
@@ -95,6 +96,48 @@ TEST(RouteTest, StraightScenarioIsOneLongStraight) {
   for (double s = 0; s <= route.length(); s += 100) EXPECT_NEAR(route.At(s).heading, 0.35, 1e-12);
 }
 
+// Every repeated piece of `route` lies on the geometry laid out before it (Distance ignores
+// repeated pieces). Returns their total length.
+double RepeatedLengthOnTheRoad(const Route& route) {
+  double repeated = 0;
+  for (const RoadPiece& piece : route.pieces()) {
+    if (!piece.repeat) continue;
+    repeated += piece.length;
+    for (double t = 0; t <= piece.length; t += piece.length / 20)
+      EXPECT_LT(route.Distance(route.At(piece.s0 + t).position), 1e-6) << "piece at " << piece.s0;
+  }
+  return repeated;
+}
+
+struct ThreeAndTwoLaps {
+  std::unique_ptr<World> three, two;
+};
+
+// The world of `scenario` with 3 and with 2 laps (no scans or images): a third lap adds no world
+// (the same buildings and as many plants), there are more than `min_buildings` buildings, and
+// every one stands clear of every road.
+ThreeAndTwoLaps BuildThreeAndTwoLaps(Scenario scenario, size_t min_buildings) {
+  SequenceOptions opt;
+  opt.scenario = scenario;
+  opt.laps = 3;
+  opt.render_images = opt.simulate_scans = false;
+  ThreeAndTwoLaps w;
+  w.three = BuildWorld(opt);
+  opt.laps = 2;
+  w.two = BuildWorld(opt);
+  const Scene& scene = w.three->scene;
+  EXPECT_EQ(w.two->scene.buildings.size(), scene.buildings.size());
+  for (size_t i = 0; i < std::min(scene.buildings.size(), w.two->scene.buildings.size()); ++i)
+    EXPECT_EQ(w.two->scene.buildings[i].center, scene.buildings[i].center);
+  EXPECT_EQ(w.two->scene.plants.size(), scene.plants.size());
+  EXPECT_GT(scene.buildings.size(), min_buildings);
+  for (const Building& b : scene.buildings)
+    for (const auto& c : b.Corners())
+      EXPECT_GT(scene.route.Distance(c),
+                scene.options.road_half_width + scene.options.sidewalk_width - 0.3);
+  return w;
+}
+
 // The loop scenario: a street, three circuits of a block and back. Every repeated piece lies on
 // the geometry laid out before it (Distance ignores repeated pieces), the drive ends where it
 // started, and the world has every building and plant once, clear of every road.
@@ -107,34 +150,13 @@ TEST(RouteTest, LoopRevisitsTheBlockAndTheStreet) {
   const double circuit = 2 * (130 + 110) - 8 * 12 + 2 * M_PI * 12;
   EXPECT_NEAR(route.length(), 150 + 3 * circuit + 150, 1e-6);
   EXPECT_LT((route.At(route.length()).position - Eigen::Vector2d(5, -3)).norm(), 1e-9);
-  double repeated = 0;
-  for (const RoadPiece& piece : route.pieces()) {
-    if (!piece.repeat) continue;
-    repeated += piece.length;
-    for (double t = 0; t <= piece.length; t += piece.length / 20)
-      EXPECT_LT(route.Distance(route.At(piece.s0 + t).position), 1e-6) << "piece at " << piece.s0;
-  }
+  const double repeated = RepeatedLengthOnTheRoad(route);
   // Revisited: circuits 2 and 3 but for the new left turn at J, and the street back.
   EXPECT_NEAR(repeated, 2 * circuit - 12 * M_PI / 2 + 138, 1e-6);
-  SequenceOptions opt;
-  opt.scenario = Scenario::kLoop;
-  opt.laps = 3;
-  opt.render_images = opt.simulate_scans = false;
-  const auto world = BuildWorld(opt);
-  const Scene& scene = world->scene;
-  // A third circuit adds no world: the buildings and plants are those of two circuits.
-  opt.laps = 2;
-  const auto two = BuildWorld(opt);
-  ASSERT_EQ(two->scene.buildings.size(), scene.buildings.size());
-  for (size_t i = 0; i < scene.buildings.size(); ++i)
-    EXPECT_EQ(two->scene.buildings[i].center, scene.buildings[i].center);
-  ASSERT_EQ(two->scene.plants.size(), scene.plants.size());
-  EXPECT_LE(scene.poles.size(), two->scene.poles.size() + 2);  // Poles along the way out move.
-  ASSERT_GT(scene.buildings.size(), 20u);
-  for (const Building& b : scene.buildings)
-    for (const auto& c : b.Corners())
-      EXPECT_GT(scene.route.Distance(c),
-                scene.options.road_half_width + scene.options.sidewalk_width - 0.3);
+  const ThreeAndTwoLaps worlds = BuildThreeAndTwoLaps(Scenario::kLoop, 20);
+  const Scene& scene = worlds.three->scene;
+  // Poles along the way out move.
+  EXPECT_LE(scene.poles.size(), worlds.two->scene.poles.size() + 2);
   for (size_t i = 0; i < scene.plants.size(); ++i)
     for (size_t j = 0; j < i; ++j)
       EXPECT_GT((scene.plants[i].center - scene.plants[j].center).norm(), 1.0);
@@ -147,6 +169,8 @@ TEST(RouteTest, LoopRevisitsTheBlockAndTheStreet) {
 TEST(RouteTest, FigureEightCrossesItselfAndRevisitsBothBlocks) {
   EXPECT_EQ(ParseScenario("figure8"), Scenario::kFigureEight);
   EXPECT_EQ(ToString(Scenario::kFigureEight), "figure8");
+  EXPECT_TRUE(IsUrbanLike(Scenario::kFigureEight));  // The loop's city scenery.
+  EXPECT_FALSE(IsUrbanLike(Scenario::kSuburban));
   const Route route(ScenarioRoute(Scenario::kFigureEight, 3), Eigen::Vector2d(5, -3), 0.35);
   const double R = 12, arc = M_PI / 2 * R;
   // Round B (four sides, three corners) and round A from X to the corner before J (three
@@ -156,13 +180,7 @@ TEST(RouteTest, FigureEightCrossesItselfAndRevisitsBothBlocks) {
   EXPECT_NEAR(route.length(), 150 + (130 + b + a) + 2 * (arc + 130 - R + b + a) + arc + 150 - R,
               1e-6);
   EXPECT_LT((route.At(route.length()).position - Eigen::Vector2d(5, -3)).norm(), 1e-9);
-  double repeated = 0;
-  for (const RoadPiece& piece : route.pieces()) {
-    if (!piece.repeat) continue;
-    repeated += piece.length;
-    for (double t = 0; t <= piece.length; t += piece.length / 20)
-      EXPECT_LT(route.Distance(route.At(piece.s0 + t).position), 1e-6) << "piece at " << piece.s0;
-  }
+  const double repeated = RepeatedLengthOnTheRoad(route);
   // Revisited: eights 2 and 3 but for the new right corner at J, and the street back.
   EXPECT_NEAR(repeated, 2 * (arc + 130 - R + b + a) - arc + 150 - R, 1e-6);
   // X: 280 m (the street and J-X) into the drive, in the start heading; again after B's
@@ -170,23 +188,7 @@ TEST(RouteTest, FigureEightCrossesItselfAndRevisitsBothBlocks) {
   const RoadPoint west = route.At(150 + 130), north = route.At(150 + 130 + b);
   EXPECT_LT((west.position - north.position).norm(), 1e-6);
   EXPECT_NEAR(std::remainder(north.heading - west.heading, 2 * M_PI), -M_PI / 2, 1e-9);
-  SequenceOptions opt;
-  opt.scenario = Scenario::kFigureEight;
-  opt.laps = 3;
-  opt.render_images = opt.simulate_scans = false;
-  const auto three = BuildWorld(opt);
-  opt.laps = 2;
-  const auto two = BuildWorld(opt);
-  const Scene& scene = three->scene;
-  ASSERT_EQ(two->scene.buildings.size(), scene.buildings.size());
-  for (size_t i = 0; i < scene.buildings.size(); ++i)
-    EXPECT_EQ(two->scene.buildings[i].center, scene.buildings[i].center);
-  ASSERT_EQ(two->scene.plants.size(), scene.plants.size());
-  ASSERT_GT(scene.buildings.size(), 30u);
-  for (const Building& bd : scene.buildings)
-    for (const auto& c : bd.Corners())
-      EXPECT_GT(scene.route.Distance(c),
-                scene.options.road_half_width + scene.options.sidewalk_width - 0.3);
+  BuildThreeAndTwoLaps(Scenario::kFigureEight, 30);
 }
 
 TEST(DriveTest, DefaultDemoMeetsTheBrief) {

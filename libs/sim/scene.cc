@@ -195,9 +195,7 @@ void PlaceStreetFurniture(Scene& scene, Rng& rng) {
 
 void PlacePlants(Scene& scene, Rng& rng) {
   const double hw = scene.options.road_half_width;
-  const bool green = scene.options.scenario != Scenario::kUrban &&
-                     scene.options.scenario != Scenario::kLoop &&
-                     scene.options.scenario != Scenario::kFigureEight;
+  const bool green = !IsUrbanLike(scene.options.scenario);
   for (const RoadPiece& piece : scene.route.pieces()) {
     if (piece.repeat) continue;
     const double spacing = piece.open ? 7.0 : (green ? 14.0 : 30.0);
