@@ -4,7 +4,8 @@
 Usage: scripts/sensor_fidelity.py [--markdown FILE] [--band 0.3] [--fraction-floor 0.03]
                                   REAL=STATS.json NAME=STATS.json [NAME=STATS.json ...]
 
-Each STATS.json is a sensor_stats artifact (build/bin/sensor_stats -d SEQUENCE -o STATS.json).
+Each STATS.json is a sensor_stats artifact (build/bin/sensor_stats -d SEQUENCE -o STATS.json;
+with --odometry ODOM.h5 --vps VPS.h5 --visual VISUAL.h5 it also holds what the stages see).
 The first drive is the reference. For every statistic the table has the median over the frames
 of each drive; a simulated value outside the band around the reference is marked with "!":
 outside +-band (relative, default 30 %) and, for fractions (statistics in [0, 1] whose name does
@@ -19,17 +20,22 @@ import sys
 
 from sim_fidelity import write_atomic
 
-SECTIONS = ("scan", "image")
+SECTIONS = ("scan", "image", "stages")
 # Statistics whose value is a count or a length: compared by the relative band only.
 NOT_FRACTIONS = {
     "points", "rings", "ring_points_median", "ring_points_p10", "range_median_m", "shape_voxels",
     "intensity_median", "intensity_p90", "mean", "contrast", "local_contrast", "gradient_mean",
     "gradient_p90", "fast_corners", "orb_keypoints", "far_ahead", "far_behind", "far_ahead_p10",
-    "far_behind_p10",
+    "far_behind_p10", "odom_rpe_m_mean", "odom_rpe_percent", "odom_drift_percent",
+    "vp_forward_error_deg", "vp_forward_error_deg_p90", "visual_points", "visual_reprojection_px",
 }
 # Statistics whose 10 % quantile over the frames is compared too: the frames where the scanner
 # sees no world ahead or behind are a tail, not the median.
 WITH_P10 = {"far_ahead", "far_behind"}
+# Statistics whose 90 % quantile is compared too (the tail of an error).
+WITH_P90 = {"vp_forward_error_deg"}
+# Statistics compared by their mean: a rate (0 or 1 per frame), or an error whose outliers matter.
+BY_MEAN = {"vp_forward_found", "odom_rpe_m"}
 
 
 def load(path):
@@ -46,9 +52,14 @@ def load(path):
         if part is None:
             continue
         for name, v in part.items():
-            out[(section, name)] = v.get("median")
+            if name in BY_MEAN:
+                out[(section, name + "_mean")] = v.get("mean")
+            else:
+                out[(section, name)] = v.get("median")
             if name in WITH_P10:
                 out[(section, name + "_p10")] = v.get("p10")
+            if name in WITH_P90:
+                out[(section, name + "_p90")] = v.get("p90")
     if not out:
         raise ValueError(f"{path}: no statistics")
     return out, len(doc.get("frames", []))

@@ -17,20 +17,25 @@
 #include "core/strings.h"
 #include "core/threads.h"
 #include "fidelity/sensor_stats.h"
+#include "fidelity/stage_stats.h"
 #include "io/artifact.h"
 #include "io/dataset.h"
+#include "io/trajectory_io.h"
+#include "io/visual_io.h"
+#include "io/vps_io.h"
 
 int main(int argc, char** argv) {
   jvl::app::Tool tool("sensor_stats",
                       "Statistics of the raw LiDAR scans and camera images of a sequence (real or "
                       "simulated), for the simulator's fidelity table: median, 10 % and 90 % "
                       "quantile over the frames of every statistic, and the per-frame values.");
-  std::string dataset_dir, frames = ":", output;
+  std::string dataset_dir, frames = ":", output, gt_path, odometry_path, vps_path, visual_path;
   jvl::io::DatasetOptions dataset_options;
   int every = 1, camera = 0;
   bool no_scans = false, no_images = false;
   jvl::fidelity::ScanStatsOptions scan_options;
   jvl::fidelity::ImageStatsOptions image_options;
+  jvl::fidelity::StageStatsOptions stage_options;
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
@@ -44,6 +49,22 @@ int main(int argc, char** argv) {
       cli.add_option("-o,--output", output, "Output JSON (sensor_stats artifact)")->required());
   cli.add_flag("--no-scans", no_scans, "Skip the LiDAR statistics");
   cli.add_flag("--no-images", no_images, "Skip the image statistics");
+  jvl::app::OptionGroup stages(tool, "What the stages see (against the ground truth)");
+  stages.Add("--odometry", odometry_path,
+             "A trajectory of the sequence (lidar_odom's odom.h5, KITTI or TUM text): its frame-to-"
+             "frame error and drift");
+  stages.Add("--vps", vps_path,
+             "vp_detect's vps artifact: forward VP found, its angle to the "
+             "direction of travel");
+  stages.Add("--visual", visual_path,
+             "visual_assoc's visual artifact: map points, tracked share of the keypoints and "
+             "reprojection error per keyframe");
+  stages.Add("--gt", gt_path,
+             "Ground-truth poses for --odometry and --vps (default: the dataset's own)");
+  stages.Add("--drift-length", stage_options.drift_length_m,
+             "Path length of the odometry's drift windows (m)");
+  stages.Add("--vp-lookahead", stage_options.vp_lookahead_m,
+             "The direction of travel points at the position this far ahead (m)");
   jvl::app::OptionGroup stats(tool, "Statistics");
   stats.Add("--sensor-height", scan_options.sensor_height,
             "Nominal height of the LiDAR above the road (m)");
@@ -59,7 +80,9 @@ int main(int argc, char** argv) {
   return tool.Run(argc, argv, [&] {
     scan_options.Check();
     image_options.Check();
-    JVL_CHECK(!(no_scans && no_images), "sensor_stats: --no-scans and --no-images leave nothing");
+    const bool any_stage = !odometry_path.empty() || !vps_path.empty() || !visual_path.empty();
+    JVL_CHECK(!(no_scans && no_images && !any_stage),
+              "sensor_stats: --no-scans and --no-images leave nothing (without a stage artifact)");
     cv::setNumThreads(1);  // Parallelism is over frames.
     const auto dataset =
         jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
@@ -70,8 +93,9 @@ int main(int argc, char** argv) {
       used.push_back(dataset->frames()[i]);
     std::vector<jvl::fidelity::ScanStats> scans(no_scans ? 0 : used.size());
     std::vector<jvl::fidelity::ImageStats> images(no_images ? 0 : used.size());
-    jvl::Progress progress("frames", static_cast<int64_t>(used.size()), !tool.quiet());
-    jvl::ParallelFor(static_cast<int64_t>(used.size()), tool.threads(), [&](int64_t i) {
+    const int64_t sensor_frames = no_scans && no_images ? 0 : static_cast<int64_t>(used.size());
+    jvl::Progress progress("frames", sensor_frames, !tool.quiet() && sensor_frames > 0);
+    jvl::ParallelFor(sensor_frames, tool.threads(), [&](int64_t i) {
       if (!no_scans)
         scans[i] = jvl::fidelity::ComputeScanStats(dataset->LoadScan(used[i]), scan_options);
       if (!no_images)
@@ -83,6 +107,38 @@ int main(int argc, char** argv) {
     body["frames"] = used;
     body["scan"] = no_scans ? nlohmann::json() : jvl::fidelity::SummariseScans(scans);
     body["image"] = no_images ? nlohmann::json() : jvl::fidelity::SummariseImages(images);
+    body["stages"] = nlohmann::json();
+    if (any_stage) {
+      stage_options.Check();
+      // The ground truth over the frame range (every frame, whatever --every).
+      jvl::Trajectory gt;
+      if (!gt_path.empty()) {
+        const jvl::Trajectory all = jvl::io::ReadTrajectory(gt_path);
+        for (const int64_t f : dataset->frames())
+          if (const auto i = all.IndexOf(f)) gt.Append(f, all.world_from_cam[*i]);
+      } else if (dataset->ground_truth()) {
+        const jvl::Trajectory& all = *dataset->ground_truth();
+        for (const int64_t f : dataset->frames())
+          if (const auto i = all.IndexOf(f)) gt.Append(f, all.world_from_cam[*i]);
+      }
+      JVL_CHECK(gt.size() >= 2 || (odometry_path.empty() && vps_path.empty()),
+                "sensor_stats: --odometry and --vps need ground-truth poses of the frames (the "
+                "dataset has "
+                    << gt.size() << "; give --gt POSES)");
+      if (gt.empty())  // --visual alone: its keyframes need no ground truth.
+        for (const int64_t f : dataset->frames()) gt.Append(f, jvl::Rigid3d());
+      jvl::fidelity::StageSeries series = jvl::fidelity::MakeStageSeries(gt);
+      if (!odometry_path.empty())
+        jvl::fidelity::AddOdometryStats(gt, jvl::io::ReadTrajectory(odometry_path), stage_options,
+                                        &series);
+      if (!vps_path.empty())
+        jvl::fidelity::AddVpStats(gt, jvl::io::ReadVpsArtifact(vps_path), stage_options, &series);
+      if (!visual_path.empty())
+        jvl::fidelity::AddVisualStats(jvl::io::ReadVisualMap(visual_path), &series);
+      body["stage_frames"] = series.frames;
+      body["stages"] = jvl::fidelity::SummariseStages(series, !odometry_path.empty(),
+                                                      !vps_path.empty(), !visual_path.empty());
+    }
     jvl::io::WriteJsonArtifact(output, "sensor_stats", 1, body, tool.MakeProvenance());
     auto report = [&](const char* kind, const nlohmann::json& part) {
       if (part.is_null()) return;
@@ -94,6 +150,7 @@ int main(int argc, char** argv) {
     };
     report("scan ", body["scan"]);
     report("image", body["image"]);
+    report("stage", body["stages"]);
     spdlog::info("sensor_stats: {} frames of {} -> {}", used.size(), dataset->id(), output);
   });
 }
