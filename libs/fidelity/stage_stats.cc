@@ -59,6 +59,8 @@ void StageStatsOptions::Check() const {
             "stage stats: min_step_m must be >= 0, got " << min_step_m);
   JVL_CHECK(std::isfinite(vp_lookahead_m) && vp_lookahead_m > 0,
             "stage stats: vp_lookahead_m must be > 0, got " << vp_lookahead_m);
+  JVL_CHECK(std::isfinite(vp_max_turn_deg) && vp_max_turn_deg > 0,
+            "stage stats: vp_max_turn_deg must be > 0, got " << vp_max_turn_deg);
 }
 
 StageSeries MakeStageSeries(const Trajectory& ground_truth) {
@@ -124,6 +126,9 @@ void AddVpStats(const Trajectory& g, const io::VpsData& vps, const StageStatsOpt
     j = std::max(j, k);
     while (j < g.size() && path[j] - path[k] < options.vp_lookahead_m) ++j;
     if (!forward[k] || j == g.size()) continue;
+    const Eigen::Quaterniond turn =
+        g.world_from_cam[k].rotation().inverse() * g.world_from_cam[j].rotation();
+    if (Eigen::AngleAxisd(turn).angle() * kRadToDeg > options.vp_max_turn_deg) continue;
     // Rectified cameras share camera 0's rotation: the direction holds for any camera choice.
     const Eigen::Vector3d travel =
         (g.world_from_cam[k].Inverse() * g.world_from_cam[j].translation()).normalized();

@@ -19,6 +19,10 @@ struct StageStatsOptions {
   double drift_length_m = 50;  // Path length of the odometry's drift windows (m).
   double min_step_m = 0.1;     // Frame steps shorter than this get no relative RPE (%).
   double vp_lookahead_m = 20;  // The direction of travel: towards the position this far ahead.
+  // The forward VP's error only where the road ahead is straight: the ground truth turns by at
+  // most this much over the lookahead (deg). On a bend the lines ahead are not along the
+  // direction of travel, and a straight real excerpt has no bends to compare with.
+  double vp_max_turn_deg = 2;
   void Check() const;
 };
 
@@ -34,7 +38,8 @@ struct StageSeries {
   // vp_detect: 1 where the frame has a forward VP, 0 where it has none (NaN where vp_detect did
   // not run); the angle between the forward VP's direction and the direction of travel (the
   // ground truth's position vp_lookahead_m further along the path, in the frame's camera), NaN
-  // without a forward VP or without that much path ahead.
+  // without a forward VP, without that much path ahead, or where the ground truth turns by more
+  // than vp_max_turn_deg over it.
   std::vector<double> vp_forward_found, vp_forward_error_deg;
   // visual_assoc, at its keyframes: observations (map points seen), the share of the keyframe's
   // keypoints that observe a map point, and the median reprojection error of its observations

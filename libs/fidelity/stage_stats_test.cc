@@ -80,11 +80,12 @@ TEST(StageStats, ForwardVpAgainstTheDirectionOfTravelAhead) {
   side.frame = 7;
   side.direction = Eigen::Vector3d::UnitX();
   vps.vps.push_back(side);
-  // Frame 35: the path 20 m ahead turns; the exact direction to it gives no error, the
-  // optical axis does.
+  // Frame 21: the path turns by 1 deg within 20 m ahead (at frame 41); the exact direction to
+  // the position 20 m ahead gives no error. Frame 36: the path turns by 16 deg over the 20 m
+  // ahead, more than vp_max_turn_deg (2): no error is measured unless the limit is raised.
   const Eigen::Vector3d ahead =
-      gt.world_from_cam[35].Inverse() * gt.world_from_cam[55].translation();
-  add(35, ahead);
+      gt.world_from_cam[21].Inverse() * gt.world_from_cam[41].translation();
+  add(21, ahead);
   add(36, Eigen::Vector3d::UnitZ());
   add(65, Eigen::Vector3d::UnitZ());  // Less than 20 m of path ahead: found, no error.
   StageSeries s = MakeStageSeries(gt);
@@ -95,7 +96,12 @@ TEST(StageStats, ForwardVpAgainstTheDirectionOfTravelAhead) {
   EXPECT_NEAR(s.vp_forward_error_deg[5], 0, 1e-6);
   EXPECT_NEAR(s.vp_forward_error_deg[6], 1.0, 1e-6);
   EXPECT_TRUE(std::isnan(s.vp_forward_error_deg[7]));
-  EXPECT_NEAR(s.vp_forward_error_deg[35], 0, 1e-6);
+  EXPECT_NEAR(s.vp_forward_error_deg[21], 0, 1e-6);
+  EXPECT_EQ(s.vp_forward_found[36], 1.0);
+  EXPECT_TRUE(std::isnan(s.vp_forward_error_deg[36]));
+  StageStatsOptions wide;
+  wide.vp_max_turn_deg = 30;
+  AddVpStats(gt, vps, wide, &s);
   EXPECT_GT(s.vp_forward_error_deg[36], 1.0);
   EXPECT_EQ(s.vp_forward_found[65], 1.0);
   EXPECT_TRUE(std::isnan(s.vp_forward_error_deg[65]));
@@ -181,6 +187,9 @@ TEST(StageStats, BadOptions) {
   EXPECT_THROW(o.Check(), std::exception);
   o = StageStatsOptions{};
   o.vp_lookahead_m = std::nan("");
+  EXPECT_THROW(o.Check(), std::exception);
+  o = StageStatsOptions{};
+  o.vp_max_turn_deg = 0;
   EXPECT_THROW(o.Check(), std::exception);
 }
 

@@ -65,6 +65,9 @@ int main(int argc, char** argv) {
              "Path length of the odometry's drift windows (m)");
   stages.Add("--vp-lookahead", stage_options.vp_lookahead_m,
              "The direction of travel points at the position this far ahead (m)");
+  stages.Add("--vp-max-turn", stage_options.vp_max_turn_deg,
+             "The forward VP's error only where the path turns by at most this over the lookahead "
+             "(deg)");
   jvl::app::OptionGroup stats(tool, "Statistics");
   stats.Add("--sensor-height", scan_options.sensor_height,
             "Nominal height of the LiDAR above the road (m)");
