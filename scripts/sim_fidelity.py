@@ -14,6 +14,12 @@ poses/00.txt. For each drive the statistics of its frame-to-frame motion, in the
                vehicle steers into a turn
   roll, pitch  rotation about z and x per frame (deg): median (the jitter along straights),
                p99 and max
+  heading off the chord
+               where the path turns by at most 2 deg over the next 20 m: the angle about the
+               camera's y axis between its optical axis and the chord to the position 20 m
+               ahead, less the drive's median (the camera's mounting yaw): median and p90 of its
+               size (deg). The lane keeping's weave; it also enters any comparison of a forward
+               vanishing point (the road's lines) with the direction of travel.
 
 The drives are read as given; nothing is aligned or resampled (KITTI's frames are 0.103 s apart,
 the simulator's 0.1 s).
@@ -72,6 +78,27 @@ def quantile(values, q):
     return s[min(len(s) - 1, int(q * len(s)))]
 
 
+def chord_headings(poses, lookahead_m=20.0, max_turn_deg=2.0):
+    """Per frame with lookahead_m of path ahead over which the path turns by at most
+    max_turn_deg: the yaw (deg, about the camera's y axis) of the chord to the position that far
+    ahead, in the frame's camera."""
+    path = [0.0]
+    for k in range(1, len(poses)):
+        path.append(path[-1] + math.dist(poses[k - 1][1], poses[k][1]))
+    out, j = [], 0
+    for k in range(len(poses)):
+        j = max(j, k)
+        while j < len(poses) and path[j] - path[k] < lookahead_m:
+            j += 1
+        if j == len(poses):
+            break
+        r, t = relative(poses[k], poses[j])
+        turn = math.degrees(math.sqrt(sum(x * x for x in rotation_vector(r))))
+        if turn <= max_turn_deg:
+            out.append(math.degrees(math.atan2(t[0], t[2])))
+    return out
+
+
 def motion_stats(poses, rate_hz=10.0):
     steps = [relative(poses[k], poses[k + 1]) for k in range(len(poses) - 1)]
     rot = [[math.degrees(x) for x in rotation_vector(r)] for r, _ in steps]
@@ -80,8 +107,13 @@ def motion_stats(poses, rate_hz=10.0):
     yaw_change = [abs(rot[k + 1][1] - rot[k][1]) for k in range(len(rot) - 1)]
     roll = [abs(r[2]) for r in rot]
     pitch = [abs(r[0]) for r in rot]
+    chord = chord_headings(poses)
+    mount = quantile(chord, 0.5) if chord else 0.0
+    off = [abs(c - mount) for c in chord]
     return {
         "frames": len(poses),
+        "chord_median": quantile(off, 0.5) if off else float("nan"),
+        "chord_p90": quantile(off, 0.9) if off else float("nan"),
         "speed_median": quantile(speed, 0.5), "speed_max": max(speed),
         "yaw_p99": quantile(yaw, 0.99), "yaw_max": max(yaw),
         "yaw_change_p99": quantile(yaw_change, 0.99), "yaw_change_max": max(yaw_change),
@@ -93,8 +125,9 @@ def motion_stats(poses, rate_hz=10.0):
 
 HEADER = ("| drive | frames | speed median / max (m/s) | yaw per frame p99 / max (deg) | "
           "yaw change p99 / max (deg) | roll per frame median / p99 / max (deg) | "
-          "pitch per frame median / p99 / max (deg) |\n"
-          "|---|---:|---|---|---|---|---|")
+          "pitch per frame median / p99 / max (deg) | heading off the 20 m chord median / p90 "
+          "(deg) |\n"
+          "|---|---:|---|---|---|---|---|---|")
 
 
 def row(name, s):
@@ -102,7 +135,8 @@ def row(name, s):
             f"{s['yaw_p99']:.3f} / {s['yaw_max']:.3f} | "
             f"{s['yaw_change_p99']:.3f} / {s['yaw_change_max']:.3f} | "
             f"{s['roll_median']:.4f} / {s['roll_p99']:.3f} / {s['roll_max']:.3f} | "
-            f"{s['pitch_median']:.4f} / {s['pitch_p99']:.3f} / {s['pitch_max']:.3f} |")
+            f"{s['pitch_median']:.4f} / {s['pitch_p99']:.3f} / {s['pitch_max']:.3f} | "
+            f"{s['chord_median']:.3f} / {s['chord_p90']:.3f} |")
 
 
 def main(argv):

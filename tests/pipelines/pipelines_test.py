@@ -368,7 +368,23 @@ class SimFidelity(unittest.TestCase):
         self.assertEqual(rows["step"][3], "0.000 / 2.000")    # yaw change: one step of 2 deg
         self.assertEqual(rows["ramp"][3], "0.250 / 0.250")    # ramped in 0.25 deg per frame
         self.assertEqual(rows["ramp"][4], "0.0000 / 0.000 / 0.000")  # no roll
+        self.assertEqual(rows["step"][6], "0.000 / 0.000")  # straight: along its chords
         self.assertEqual(read(md), out.stdout)
+
+    def test_weave_is_the_heading_off_the_chord(self):
+        # The heading weaves by +-1 deg with a 70 m period (1 m per frame): the optical axis
+        # leaves the chord to the position 20 m ahead by up to about 1.5 deg.
+        heading = [math.sin(2 * math.pi * k / 70) for k in range(401)]
+        weave = self.drive("weave.txt", [heading[k + 1] - heading[k] for k in range(400)])
+        straight = self.drive("straight.txt", [0.0] * 400)
+        out = run([sys.executable, FIDELITY_PY, "weave=" + weave, "straight=" + straight])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        rows = {line.split("|")[1].strip(): [c.strip() for c in line.split("|")[2:-1]]
+                for line in out.stdout.splitlines()[2:]}
+        median, p90 = (float(x) for x in rows["weave"][6].split(" / "))
+        self.assertGreater(median, 0.4)
+        self.assertLess(p90, 1.6)
+        self.assertEqual(rows["straight"][6], "0.000 / 0.000")
 
     def test_bad_input(self):
         bad = os.path.join(self.dir, "bad.txt")
@@ -476,6 +492,29 @@ class SensorFidelity(unittest.TestCase):
         out = run([sys.executable, SENSOR_FIDELITY_PY, "--band", "0.5", "real=" + real,
                    "sim=" + sim])
         self.assertIn("| scan ground | 0.500 | 0.700 |", out.stdout)
+
+    def test_stages_by_mean_and_tail(self):
+        def doc(name, found, error):
+            path = os.path.join(self.dir, name)
+            stat = lambda mean, median, p90: {"mean": mean, "median": median, "p10": median,
+                                              "p90": p90, "frames": [median]}
+            with open(path, "w") as f:
+                json.dump({"schema": "sensor_stats", "schema_version": 1, "provenance": {},
+                           "frames": [0], "scan": None, "image": None, "stage_frames": [0],
+                           "stages": {"vp_forward_found": stat(found, 1.0, 1.0),
+                                      "vp_forward_error_deg": stat(0.0, *error)}}, f)
+            return path
+        real = doc("real.json", 1.0, (0.14, 0.24))
+        sim = doc("sim.json", 0.6, (0.16, 0.70))
+        out = run([sys.executable, SENSOR_FIDELITY_PY, "real=" + real, "sim=" + sim])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        rows = {line.split("|")[1].strip(): [c.strip() for c in line.split("|")[2:-1]]
+                for line in out.stdout.splitlines()[2:]}
+        # The rate by its mean (its median is 1 on both), the error by median and p90.
+        self.assertEqual(rows["stages vp_forward_found_mean"], ["1.000", "0.600 !"])
+        self.assertEqual(rows["stages vp_forward_error_deg"], ["0.140", "0.160"])
+        self.assertEqual(rows["stages vp_forward_error_deg_p90"], ["0.240", "0.700 !"])
+        self.assertNotIn("stages vp_forward_found", rows)
 
     def test_bad_input(self):
         real = self.stats("real.json", {"points": 1000})
