@@ -27,7 +27,8 @@ NOT_FRACTIONS = {
     "intensity_median", "intensity_p90", "mean", "contrast", "local_contrast", "gradient_mean",
     "gradient_p90", "fast_corners", "orb_keypoints", "far_ahead", "far_behind", "far_ahead_p10",
     "far_behind_p10", "odom_rpe_m_mean", "odom_rpe_percent", "odom_drift_percent",
-    "vp_forward_error_deg", "vp_forward_error_deg_p90", "visual_points", "visual_reprojection_px",
+    "odom_direction_yaw_deg", "odom_direction_pitch_deg", "vp_forward_error_deg",
+    "vp_forward_error_deg_p90", "visual_points", "visual_reprojection_px",
 }
 # Statistics whose 10 % quantile over the frames is compared too: the frames where the scanner
 # sees no world ahead or behind are a tail, not the median.

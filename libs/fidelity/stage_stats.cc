@@ -67,9 +67,10 @@ StageSeries MakeStageSeries(const Trajectory& ground_truth) {
   StageSeries s;
   s.frames = ground_truth.frames;
   const size_t n = ground_truth.size();
-  for (auto* v : {&s.odom_rpe_m, &s.odom_rpe_percent, &s.odom_drift_percent, &s.vp_forward_found,
-                  &s.vp_forward_error_deg, &s.visual_points, &s.visual_tracked_fraction,
-                  &s.visual_reprojection_px})
+  for (auto* v :
+       {&s.odom_rpe_m, &s.odom_rpe_percent, &s.odom_drift_percent, &s.odom_direction_yaw_deg,
+        &s.odom_direction_pitch_deg, &s.vp_forward_found, &s.vp_forward_error_deg, &s.visual_points,
+        &s.visual_tracked_fraction, &s.visual_reprojection_px})
     v->assign(n, kNan);
   return s;
 }
@@ -97,6 +98,18 @@ void AddOdometryStats(const Trajectory& g, const Trajectory& estimate,
     const double step = path[k + 1] - path[k];
     series->odom_rpe_m[k + 1] = e;
     series->odom_rpe_percent[k + 1] = step >= options.min_step_m ? 100.0 * e / step : kNan;
+    if (step < options.min_step_m || !row[k] || !row[k + 1]) continue;
+    const Eigen::Vector3d t =
+        (g.world_from_cam[k].Inverse() * g.world_from_cam[k + 1]).translation();
+    const Eigen::Vector3d m =
+        (estimate.world_from_cam[*row[k]].Inverse() * estimate.world_from_cam[*row[k + 1]])
+            .translation();
+    auto yaw = [](const Eigen::Vector3d& v) { return std::atan2(v.x(), v.z()); };
+    auto pitch = [](const Eigen::Vector3d& v) {
+      return std::atan2(v.y(), std::hypot(v.x(), v.z()));
+    };
+    series->odom_direction_yaw_deg[k + 1] = (yaw(m) - yaw(t)) * kRadToDeg;
+    series->odom_direction_pitch_deg[k + 1] = (pitch(m) - pitch(t)) * kRadToDeg;
   }
   size_t j = 0;
   for (size_t k = 0; k < g.size(); ++k) {
@@ -172,7 +185,9 @@ nlohmann::json SummariseStages(const StageSeries& s, bool odometry, bool vps, bo
   const std::vector<std::pair<const char*, const std::vector<double>*>> parts[3] = {
       {{"odom_rpe_m", &s.odom_rpe_m},
        {"odom_rpe_percent", &s.odom_rpe_percent},
-       {"odom_drift_percent", &s.odom_drift_percent}},
+       {"odom_drift_percent", &s.odom_drift_percent},
+       {"odom_direction_yaw_deg", &s.odom_direction_yaw_deg},
+       {"odom_direction_pitch_deg", &s.odom_direction_pitch_deg}},
       {{"vp_forward_found", &s.vp_forward_found},
        {"vp_forward_error_deg", &s.vp_forward_error_deg}},
       {{"visual_points", &s.visual_points},

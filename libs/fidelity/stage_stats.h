@@ -35,6 +35,13 @@ struct StageSeries {
   // same error over the first frame j whose path length from k reaches drift_length_m, divided
   // by that path length (%).
   std::vector<double> odom_rpe_m, odom_rpe_percent, odom_drift_percent;
+  // At frame k+1, the direction of the estimate's step from k against the truth's, in frame
+  // k's camera (x right, y down, z forward): the difference of their angles atan2(x, z) (yaw,
+  // right positive) and atan2(y, hypot(x, z)) (pitch, down positive), deg. Their median over a
+  // drive is a rotation between the frame the estimate's motion is expressed in and the ground
+  // truth's (a camera-LiDAR calibration error, or the ground truth's own); NaN for steps
+  // shorter than min_step_m.
+  std::vector<double> odom_direction_yaw_deg, odom_direction_pitch_deg;
   // vp_detect: 1 where the frame has a forward VP, 0 where it has none (NaN where vp_detect did
   // not run); the angle between the forward VP's direction and the direction of travel (the
   // ground truth's position vp_lookahead_m further along the path, in the frame's camera), NaN

@@ -44,6 +44,11 @@ TEST(StageStats, OdometryStepIsSeenOnceAndInTheDriftWindowsOverIt) {
   EXPECT_NEAR(s.odom_rpe_m[29], 0, 1e-12);
   EXPECT_NEAR(s.odom_rpe_m[31], 0, 1e-12);
   EXPECT_TRUE(std::isnan(s.odom_rpe_m[70]) && std::isnan(s.odom_rpe_m[71]));
+  // The step at frame 30 points 0.05 m right of the 1 m the car moved: atan(0.05) to the right.
+  EXPECT_NEAR(s.odom_direction_yaw_deg[30], std::atan(0.05) * 180 / M_PI, 1e-9);
+  EXPECT_NEAR(s.odom_direction_pitch_deg[30], 0, 1e-9);
+  EXPECT_NEAR(s.odom_direction_yaw_deg[31], 0, 1e-9);
+  EXPECT_TRUE(std::isnan(s.odom_direction_yaw_deg[70]));
   // 50 m windows: those from frames 0..29 end at 50..79 and span the step (frame 20's window
   // ends at frame 70, which the estimate lacks); those from 30 on do not; from 50 on there is
   // not 50 m of path left.
@@ -58,6 +63,24 @@ TEST(StageStats, OdometryStepIsSeenOnceAndInTheDriftWindowsOverIt) {
   other.Append(500, Rigid3d());
   other.Append(501, Rigid3d());
   EXPECT_THROW(AddOdometryStats(gt, other, o, &s), std::exception);
+}
+
+TEST(StageStats, OdometryExpressedInARotatedFrameShowsAsADirectionBias) {
+  // The estimate's motion expressed in a frame pitched 0.3 deg down and yawed 0.5 deg right of
+  // the camera (x_est = R x_cam): every step's direction is off by that much.
+  const Trajectory gt = Drive(40);
+  const Eigen::Quaterniond r(Eigen::AngleAxisd(-0.3 * M_PI / 180, Eigen::Vector3d::UnitX()) *
+                             Eigen::AngleAxisd(0.5 * M_PI / 180, Eigen::Vector3d::UnitY()));
+  const Rigid3d off(r, Eigen::Vector3d::Zero());
+  Trajectory est;
+  for (size_t k = 0; k < gt.size(); ++k)
+    est.Append(gt.frames[k], off * gt.world_from_cam[k] * off.Inverse());
+  StageSeries s = MakeStageSeries(gt);
+  AddOdometryStats(gt, est, StageStatsOptions{}, &s);
+  for (size_t k = 1; k < gt.size(); ++k) {
+    EXPECT_NEAR(s.odom_direction_yaw_deg[k], 0.5, 1e-3);
+    EXPECT_NEAR(s.odom_direction_pitch_deg[k], 0.3, 1e-3);
+  }
 }
 
 TEST(StageStats, ForwardVpAgainstTheDirectionOfTravelAhead) {
