@@ -477,6 +477,10 @@ TEST_F(BadInputTest, ArtifactsOfDifferentSequences) {
               "--dataset " + kSeq + " --prior " + In("prior.h5") + " --directions " +
                   Bad("directions_01.h5") + " -o " + Bad("x.h5"),
               "directions_01.h5 was made from sequence 'kitti:01:0123abcd'");
+  ExpectError(
+      "sensor_stats",
+      "-d " + kSeq + " --no-scans --no-images --vps " + Bad("vps_01.h5") + " -o " + Bad("s.json"),
+      "vps_01.h5 was made from sequence 'kitti:01:0123abcd'");
   // The same frames under another sequence name: local_map must not take them for run_a's.
   const std::string renamed = Sequence("renamed", 40, "01");
   ExpectError("local_map",
@@ -588,6 +592,14 @@ TEST_F(BadInputTest, InvalidOptions) {
               "--no-scans and --no-images leave nothing");
   ExpectError("sensor_stats", "-d " + kSeq + " -o " + Bad("s.json") + " --shape-radius 0",
               "voxel_size and radius must be > 0");
+  ExpectError("sensor_stats",
+              "-d " + kSeq + " -o " + Bad("s.json") + " --no-scans --no-images --odometry " +
+                  In("odom.h5") + " --drift-length 0",
+              "--drift-length must be > 0");
+  ExpectError(
+      "sensor_stats",
+      "-d " + kSeq + " -o " + Bad("s.json") + " --no-scans --no-images --visual " + In("vps.h5"),
+      "expected schema 'visual'");
   const std::string loops = "-d " + kSeq + " --poses " + In("odom.h5") + " -o " + Bad("l.h5");
   ExpectError("loop_detect", loops + " --every 0", "--every");
   ExpectError("loop_detect", loops + " --max-descriptor-distance 0",

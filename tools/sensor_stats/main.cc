@@ -68,6 +68,9 @@ int main(int argc, char** argv) {
   stages.Add("--vp-max-turn", stage_options.vp_max_turn_deg,
              "The forward VP's error only where the path turns by at most this over the lookahead "
              "(deg)");
+  tool.FieldFlag("drift_length_m", "--drift-length");
+  tool.FieldFlag("vp_lookahead_m", "--vp-lookahead");
+  tool.FieldFlag("vp_max_turn_deg", "--vp-max-turn");
   jvl::app::OptionGroup stats(tool, "Statistics");
   stats.Add("--sensor-height", scan_options.sensor_height,
             "Nominal height of the LiDAR above the road (m)");
@@ -90,6 +93,10 @@ int main(int argc, char** argv) {
     const auto dataset =
         jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
+    // Stage artifacts of another sequence are refused (their provenance names it).
+    for (const std::string* path : {&odometry_path, &vps_path, &visual_path})
+      if (!path->empty()) tool.AddInput(*path);
+    if (!gt_path.empty()) tool.AddInput(gt_path, /*same_dataset=*/false);
     if (!no_images) dataset->CheckCamera(camera);
     std::vector<int64_t> used;
     for (size_t i = 0; i < dataset->frames().size(); i += static_cast<size_t>(every))
