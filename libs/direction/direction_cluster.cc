@@ -321,7 +321,7 @@ DirectionClusterResult ClusterDirections(const std::vector<VpObservation>& vps,
   const std::vector<Candidate> cands = ForwardFilter(vps, prior, camera, ground, options, &st);
   st.forward_kept = int(cands.size());
   std::vector<Group> groups = FirstLevel(cands, ground, options, &st);
-  const std::vector<double> path = PathLength(prior);
+  const std::vector<double> path = PathLengths(prior);
   groups = KeepPerWindow(cands, path, std::move(groups), options);
   st.window_kept = int(groups.size());
   groups = SecondLevel(cands, prior, ground, groups, options);

@@ -45,16 +45,6 @@ std::vector<Eigen::Vector2d> ForwardDirections(const Trajectory& prior, const Gr
   return fd;
 }
 
-std::vector<double> PathLength(const Trajectory& prior) {
-  std::vector<double> s(prior.size(), 0.0);
-  for (size_t i = 1; i < prior.size(); ++i) {
-    s[i] =
-        s[i - 1] +
-        (prior.world_from_cam[i].translation() - prior.world_from_cam[i - 1].translation()).norm();
-  }
-  return s;
-}
-
 double SlopeDeg(const GroundFrame& ground, const Eigen::Vector3d& direction) {
   const Eigen::Vector2d g = ground.Project(direction);
   double a = std::atan2(g.y(), g.x()) * 180.0 / M_PI;

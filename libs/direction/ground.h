@@ -29,9 +29,6 @@ GroundFrame MakeGroundFrame(const Trajectory& prior, const Eigen::Vector3d& up);
 std::vector<Eigen::Vector2d> ForwardDirections(const Trajectory& prior, const GroundFrame& ground,
                                                double baseline);
 
-// Cumulative travelled distance (m) at every prior pose.
-std::vector<double> PathLength(const Trajectory& prior);
-
 // Slope of a direction's ground projection as a heading in [0, 180) deg (sign-free, Alg. 2 l. 13).
 double SlopeDeg(const GroundFrame& ground, const Eigen::Vector3d& direction);
 

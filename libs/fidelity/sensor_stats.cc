@@ -132,21 +132,10 @@ Series ImageSeries(const std::vector<ImageStats>& s) {
 
 nlohmann::json Finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
-// {"name": {"median", "p10", "p90", "frames": [...]}} over the finite values.
+// {"name": SummariseValues(values)}.
 nlohmann::json Summarise(const Series& series) {
   nlohmann::json out = nlohmann::json::object();
-  for (const auto& [name, values] : series) {
-    std::vector<double> finite;
-    nlohmann::json per_frame = nlohmann::json::array();
-    for (double v : values) {
-      per_frame.push_back(Finite(v));
-      if (std::isfinite(v)) finite.push_back(v);
-    }
-    out[name] = {{"median", Finite(Median(finite))},
-                 {"p10", Finite(Quantile(finite, 0.1))},
-                 {"p90", Finite(Quantile(finite, 0.9))},
-                 {"frames", per_frame}};
-  }
+  for (const auto& [name, values] : series) out[name] = SummariseValues(values);
   return out;
 }
 
@@ -348,6 +337,26 @@ ImageStats ComputeImageStats(const cv::Mat& image, const ImageStatsOptions& o) {
   s.orb_cells =
       std::count_if(per_cell.begin(), per_cell.end(), [](int c) { return c > 0; }) / cells;
   return s;
+}
+
+nlohmann::json SummariseValues(const std::vector<double>& values, bool with_mean) {
+  std::vector<double> finite;
+  nlohmann::json per_frame = nlohmann::json::array();
+  for (double v : values) {
+    per_frame.push_back(Finite(v));
+    if (std::isfinite(v)) finite.push_back(v);
+  }
+  nlohmann::json out = {{"median", Finite(Median(finite))},
+                        {"p10", Finite(Quantile(finite, 0.1))},
+                        {"p90", Finite(Quantile(finite, 0.9))},
+                        {"frames", per_frame}};
+  if (with_mean) {
+    double sum = 0;
+    for (const double v : finite) sum += v;
+    out["mean"] =
+        finite.empty() ? nlohmann::json() : Finite(sum / static_cast<double>(finite.size()));
+  }
+  return out;
 }
 
 nlohmann::json SummariseScans(const std::vector<ScanStats>& stats) {

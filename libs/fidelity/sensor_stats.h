@@ -95,6 +95,10 @@ ImageStats ComputeImageStats(const cv::Mat& image, const ImageStatsOptions& opti
 // for every statistic its median, 10 % and 90 % quantile over the frames where it is finite
 // (null if none) and the per-frame values (null where not finite).
 nlohmann::json SummariseScans(const std::vector<ScanStats>& stats);
+// One statistic's summary of that form from its per-frame values (NaN where a frame has none),
+// with the mean of the finite values too when asked (the stages' statistics,
+// fidelity/stage_stats.h).
+nlohmann::json SummariseValues(const std::vector<double>& values, bool with_mean = false);
 nlohmann::json SummariseImages(const std::vector<ImageStats>& stats);
 
 }  // namespace jvl::fidelity

@@ -8,6 +8,7 @@
 
 #include "core/check.h"
 #include "core/statistics.h"
+#include "fidelity/sensor_stats.h"
 #include "geometry/rigid3.h"
 
 namespace jvl::fidelity {
@@ -16,38 +17,11 @@ namespace {
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-// Path length from the first ground-truth frame to each frame.
-std::vector<double> PathLengths(const Trajectory& g) {
-  std::vector<double> s(g.size(), 0.0);
-  for (size_t k = 1; k < g.size(); ++k)
-    s[k] = s[k - 1] +
-           (g.world_from_cam[k].translation() - g.world_from_cam[k - 1].translation()).norm();
-  return s;
-}
-
 // Translation error of the estimate's motion from frame row a to row b against the truth's.
 double MotionError(const Trajectory& g, size_t a, size_t b, const Rigid3d& ea, const Rigid3d& eb) {
   const Rigid3d truth = g.world_from_cam[a].Inverse() * g.world_from_cam[b];
   const Rigid3d estimate = ea.Inverse() * eb;
   return (truth.Inverse() * estimate).translation().norm();
-}
-
-nlohmann::json Finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
-nlohmann::json Summary(const std::vector<double>& values) {
-  std::vector<double> finite;
-  nlohmann::json per_frame = nlohmann::json::array();
-  double sum = 0;
-  for (const double v : values) {
-    per_frame.push_back(Finite(v));
-    if (std::isfinite(v)) finite.push_back(v), sum += v;
-  }
-  const double mean = finite.empty() ? kNan : sum / static_cast<double>(finite.size());
-  return {{"mean", Finite(mean)},
-          {"median", Finite(Median(finite))},
-          {"p10", Finite(Quantile(finite, 0.1))},
-          {"p90", Finite(Quantile(finite, 0.9))},
-          {"frames", per_frame}};
 }
 
 }  // namespace
@@ -170,8 +144,9 @@ void AddVisualStats(const io::VisualMapData& d, StageSeries* series) {
                                    : std::numeric_limits<double>::infinity());
   }
   for (size_t k = 0; k < n; ++k) {
-    const auto i = std::find(series->frames.begin(), series->frames.end(), d.keyframes.frames[k]);
-    if (i == series->frames.end()) continue;
+    const auto i =
+        std::lower_bound(series->frames.begin(), series->frames.end(), d.keyframes.frames[k]);
+    if (i == series->frames.end() || *i != d.keyframes.frames[k]) continue;
     const auto r = static_cast<size_t>(i - series->frames.begin());
     const double seen = static_cast<double>(errors[k].size());
     series->visual_points[r] = seen;
@@ -196,7 +171,8 @@ nlohmann::json SummariseStages(const StageSeries& s, bool odometry, bool vps, bo
   const bool given[3] = {odometry, vps, visual};
   for (int p = 0; p < 3; ++p)
     if (given[p])
-      for (const auto& [name, values] : parts[p]) out[name] = Summary(*values);
+      for (const auto& [name, values] : parts[p])
+        out[name] = SummariseValues(*values, /*with_mean=*/true);
   return out;
 }
 

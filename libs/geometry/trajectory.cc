@@ -35,4 +35,12 @@ void Trajectory::Append(int64_t frame, const Rigid3d& pose, std::optional<double
   if (timestamp) timestamps.push_back(*timestamp);
 }
 
+std::vector<double> PathLengths(const Trajectory& t) {
+  std::vector<double> s(t.size(), 0.0);
+  for (size_t i = 1; i < t.size(); ++i)
+    s[i] = s[i - 1] +
+           (t.world_from_cam[i].translation() - t.world_from_cam[i - 1].translation()).norm();
+  return s;
+}
+
 }  // namespace jvl

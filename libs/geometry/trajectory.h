@@ -25,4 +25,8 @@ struct Trajectory {
   void Append(int64_t frame, const Rigid3d& pose, std::optional<double> timestamp = {});
 };
 
+// Path length (m) from the first pose to every pose: the sum of the distances between
+// consecutive positions.
+std::vector<double> PathLengths(const Trajectory& trajectory);
+
 }  // namespace jvl

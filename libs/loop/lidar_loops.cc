@@ -191,16 +191,6 @@ Rigid3d LoopDisagreement(const Rigid3d& query1, const Rigid3d& match1, const Rig
   return loop2.Inverse() * predicted;
 }
 
-std::vector<double> PathLengths(const Trajectory& keyframes) {
-  std::vector<double> path(keyframes.size(), 0.0);
-  for (size_t i = 1; i < keyframes.size(); ++i) {
-    path[i] = path[i - 1] + (keyframes.world_from_cam[i].translation() -
-                             keyframes.world_from_cam[i - 1].translation())
-                                .norm();
-  }
-  return path;
-}
-
 bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, size_t q, size_t m,
                 const LidarLoopOptions& o) {
   const double apart =

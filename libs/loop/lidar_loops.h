@@ -185,8 +185,6 @@ double RelativeHeading(const Rigid3d& match_from_query);
 // match2 (world_from_cam poses), as the offset loop2^-1 * predicted (identity when they agree).
 Rigid3d LoopDisagreement(const Rigid3d& query1, const Rigid3d& match1, const Rigid3d& loop1,
                          const Rigid3d& query2, const Rigid3d& match2, const Rigid3d& loop2);
-// Path length along the keyframes' trajectory at every keyframe.
-std::vector<double> PathLengths(const Trajectory& keyframes);
 // The drift bound: keyframes q and m lie further apart in the trajectory than
 // max_prior_offset + max_prior_drift x the path length between them.
 bool FarInPrior(const Trajectory& keyframes, const std::vector<double>& path, size_t q, size_t m,

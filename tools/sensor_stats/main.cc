@@ -121,16 +121,12 @@ int main(int argc, char** argv) {
     if (any_stage) {
       stage_options.Check();
       // The ground truth over the frame range (every frame, whatever --every).
+      const jvl::Trajectory all = !gt_path.empty()          ? jvl::io::ReadTrajectory(gt_path)
+                                  : dataset->ground_truth() ? *dataset->ground_truth()
+                                                            : jvl::Trajectory();
       jvl::Trajectory gt;
-      if (!gt_path.empty()) {
-        const jvl::Trajectory all = jvl::io::ReadTrajectory(gt_path);
-        for (const int64_t f : dataset->frames())
-          if (const auto i = all.IndexOf(f)) gt.Append(f, all.world_from_cam[*i]);
-      } else if (dataset->ground_truth()) {
-        const jvl::Trajectory& all = *dataset->ground_truth();
-        for (const int64_t f : dataset->frames())
-          if (const auto i = all.IndexOf(f)) gt.Append(f, all.world_from_cam[*i]);
-      }
+      for (const int64_t f : dataset->frames())
+        if (const auto i = all.IndexOf(f)) gt.Append(f, all.world_from_cam[*i]);
       JVL_CHECK(gt.size() >= 2 || (odometry_path.empty() && vps_path.empty()),
                 "sensor_stats: --odometry and --vps need ground-truth poses of the frames (the "
                 "dataset has "
