@@ -220,7 +220,8 @@ class BadInputTest : public ::testing::Test {
 std::string BadInputTest::id_;
 
 TEST_F(BadInputTest, MissingAndDamagedDatasetFiles) {
-  for (const std::string tool : {"dataset_info", "lidar_odom", "vp_detect", "sensor_stats"}) {
+  for (const std::string tool :
+       {"dataset_info", "lidar_odom", "vp_detect", "sensor_stats", "calib_check"}) {
     const std::string out = tool == "dataset_info" ? "" : " -o " + Bad("x.h5");
     ExpectError(tool, "--dataset " + Bad("no_such_folder") + out, "no_such_folder: dataset folder");
   }
@@ -600,6 +601,16 @@ TEST_F(BadInputTest, InvalidOptions) {
       "sensor_stats",
       "-d " + kSeq + " -o " + Bad("s.json") + " --no-scans --no-images --visual " + In("vps.h5"),
       "expected schema 'visual'");
+  const std::string calib = "-d " + kSeq + " -o " + Bad("c.json");
+  ExpectError("calib_check", calib + " --min-depth 90",
+              "--min-depth must be > 0 and < --max-depth");
+  ExpectError("calib_check", calib + " --fine-step 0.5",
+              "--fine-step must be > 0 and <= --coarse-step");
+  ExpectError("calib_check", calib + " --search 20", "--search must be within");
+  ExpectError("calib_check", calib + " --vertical-correction 30", "--vertical-correction must be");
+  ExpectError("calib_check", calib + " --camera 3", "missing image of camera 3");
+  ExpectError("calib_check", calib + " --min-depth 70 --max-depth 71",
+              "too few to measure the calibration by");
   const std::string loops = "-d " + kSeq + " --poses " + In("odom.h5") + " -o " + Bad("l.h5");
   ExpectError("loop_detect", loops + " --every 0", "--every");
   ExpectError("loop_detect", loops + " --max-descriptor-distance 0",
