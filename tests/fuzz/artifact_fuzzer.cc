@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 
@@ -20,6 +22,27 @@
 #include "io/vps_io.h"
 
 namespace {
+
+// The temporary file of this process (under $TMPDIR, else /tmp), removed when the fuzzer exits:
+// every run used to leave one behind.
+class TempInput {
+ public:
+  TempInput() {
+    const char* dir = std::getenv("TMPDIR");
+    path_ = std::string(dir && *dir ? dir : "/tmp") + "/jvl_artifact_fuzz_" +
+            std::to_string(::getpid()) + ".h5";
+  }
+  ~TempInput() { std::remove(path_.c_str()); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+const std::string& InputPath() {
+  static const TempInput input;
+  return input.path();
+}
 
 void ReadAs(const std::string& schema, const std::string& path) {
   using namespace jvl::io;
@@ -46,7 +69,7 @@ extern "C" const char* __asan_default_options() {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string path = "/tmp/jvl_artifact_fuzz_" + std::to_string(::getpid()) + ".h5";
+  const std::string& path = InputPath();
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
