@@ -98,6 +98,12 @@ void EdgeAlignmentOptions::Check() const {
                                                                      << coarse_step_deg << ")");
   JVL_CHECK(coarse_step_deg <= search_deg && search_deg <= 10,
             "search_deg must be within [coarse_step_deg, 10] (got " << search_deg << ")");
+  // Grid sizes: (2 search / coarse + 1)^3 and (2 coarse / fine + 1)^3 rotations.
+  JVL_CHECK(search_deg / coarse_step_deg <= 50 && coarse_step_deg / fine_step_deg <= 25,
+            "search_deg / coarse_step_deg must be <= 50 and coarse_step_deg / fine_step_deg <= 25 "
+            "(got "
+                << search_deg / coarse_step_deg << " and " << coarse_step_deg / fine_step_deg
+                << ")");
   JVL_CHECK(bootstrap >= 0, "bootstrap must be >= 0 (got " << bootstrap << ")");
   JVL_CHECK(min_edge_points >= 1, "min_edge_points must be >= 1 (got " << min_edge_points << ")");
 }
@@ -109,6 +115,11 @@ DepthEdges FindDepthEdges(const PointCloud& scan, const EdgeAlignmentOptions& o)
   // 8 cells around it.
   std::unordered_map<int64_t, std::vector<int>> cells;
   auto key = [](int64_t e, int64_t a) { return e * 100000 + a; };
+  // Azimuth cells wrap round at +-180 deg, as do the gaps between azimuths.
+  const int64_t ring_cells = static_cast<int64_t>(std::ceil(360.0 / o.ring_azimuth_deg));
+  const int64_t column_cells = static_cast<int64_t>(std::ceil(720.0 / o.ring_azimuth_deg));
+  auto wrap_cell = [](int64_t a, int64_t cells) { return ((a % cells) + cells) % cells; };
+  auto wrap_gap = [](double gap) { return gap > 180 ? gap - 360 : gap < -180 ? gap + 360 : gap; };
   std::vector<int64_t> ce(n), ca(n);
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d& p = scan.points[i];
@@ -120,7 +131,8 @@ DepthEdges FindDepthEdges(const PointCloud& scan, const EdgeAlignmentOptions& o)
     azimuth[i] = std::atan2(p.y(), p.x()) * kDegPerRad;
     elevation[i] = std::atan2(p.z(), std::hypot(p.x(), p.y())) * kDegPerRad;
     ce[i] = static_cast<int64_t>(std::floor(elevation[i] / o.ring_elevation_deg));
-    ca[i] = static_cast<int64_t>(std::floor((azimuth[i] + 180.0) / o.ring_azimuth_deg));
+    ca[i] = wrap_cell(static_cast<int64_t>(std::floor((azimuth[i] + 180.0) / o.ring_azimuth_deg)),
+                      ring_cells);
     cells[key(ce[i], ca[i])].push_back(static_cast<int>(i));
   }
   // Cells of ring_spacing x ring_azimuth / 2 for the neighbours on the rings above and below.
@@ -130,7 +142,8 @@ DepthEdges FindDepthEdges(const PointCloud& scan, const EdgeAlignmentOptions& o)
   for (size_t i = 0; i < n; ++i) {
     if (range[i] < 0) continue;
     ve[i] = static_cast<int64_t>(std::floor(elevation[i] / o.ring_spacing_deg));
-    va[i] = static_cast<int64_t>(std::floor((azimuth[i] + 180.0) / column_azimuth));
+    va[i] = wrap_cell(static_cast<int64_t>(std::floor((azimuth[i] + 180.0) / column_azimuth)),
+                      column_cells);
     columns[key(ve[i], va[i])].push_back(static_cast<int>(i));
   }
   DepthEdges edges;
@@ -141,12 +154,12 @@ DepthEdges FindDepthEdges(const PointCloud& scan, const EdgeAlignmentOptions& o)
     double left_gap = o.ring_azimuth_deg, right_gap = o.ring_azimuth_deg;
     for (int64_t de = -1; de <= 1; ++de) {
       for (int64_t da = -1; da <= 1; ++da) {
-        const auto it = cells.find(key(ce[i] + de, ca[i] + da));
+        const auto it = cells.find(key(ce[i] + de, wrap_cell(ca[i] + da, ring_cells)));
         if (it == cells.end()) continue;
         for (const int j : it->second) {
           if (static_cast<size_t>(j) == i) continue;
           if (std::abs(elevation[j] - elevation[i]) >= o.ring_elevation_deg) continue;
-          const double gap = azimuth[j] - azimuth[i];
+          const double gap = wrap_gap(azimuth[j] - azimuth[i]);
           if (gap > 0 && (gap < right_gap || (gap == right_gap && j < right))) {
             right_gap = gap;
             right = j;
@@ -162,13 +175,13 @@ DepthEdges FindDepthEdges(const PointCloud& scan, const EdgeAlignmentOptions& o)
     double up_gap = 2 * o.ring_spacing_deg, down_gap = 2 * o.ring_spacing_deg;
     for (int64_t de = -1; de <= 1; ++de) {
       for (int64_t da = -1; da <= 1; ++da) {
-        const auto it = columns.find(key(ve[i] + de, va[i] + da));
+        const auto it = columns.find(key(ve[i] + de, wrap_cell(va[i] + da, column_cells)));
         if (it == columns.end()) continue;
         for (const int j : it->second) {
           const double rise = elevation[j] - elevation[i];
           if (std::abs(rise) <= o.ring_elevation_deg || std::abs(rise) >= o.ring_spacing_deg)
             continue;
-          const double across = std::abs(azimuth[j] - azimuth[i]);
+          const double across = std::abs(wrap_gap(azimuth[j] - azimuth[i]));
           if (across >= column_azimuth) continue;
           const double gap = std::abs(rise) + across;  // Nearer ring first, then nearer column.
           if (rise > 0 && (gap < up_gap || (gap == up_gap && j < up))) {
@@ -251,6 +264,9 @@ cv::Mat DirectionalField(const cv::Mat& gradient, bool rows, const EdgeAlignment
 
 EdgeFields EdgeField(const cv::Mat& image, const EdgeAlignmentOptions& o) {
   JVL_CHECK(!image.empty(), "edge field of an empty image");
+  JVL_CHECK(image.depth() == CV_8U && (image.channels() == 1 || image.channels() == 3),
+            "edge field: an 8-bit grey or colour image is needed (got depth "
+                << image.depth() << ", " << image.channels() << " channels)");
   cv::Mat grey;
   if (image.channels() == 3) {
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
@@ -395,6 +411,7 @@ EdgeAlignmentResult AlignEdges(const std::vector<AlignmentFrame>& frames,
         centre + Eigen::Vector3d(fine[idx[0]], fine[idx[1]], fine[idx[2]]);
     if (!border || move == 5 || moved.cwiseAbs().maxCoeff() > o.search_deg + 1e-9) {
       result.correction_deg = centre + peak;
+      result.at_search_limit |= border;  // Still on the border: not a maximum found.
       break;
     }
     centre = moved;
@@ -407,8 +424,14 @@ EdgeAlignmentResult AlignEdges(const std::vector<AlignmentFrame>& frames,
   for (int b = 0; b < o.bootstrap; ++b) {
     std::vector<int> counts(nf, 0);
     for (size_t k = 0; k < nf; ++k) ++counts[pick(rng)];
-    const Eigen::Vector3d c = centre + GridPeak(totals(fine_scores, counts), fine, o.fine_step_deg);
+    size_t best = 0;
+    const Eigen::Vector3d c =
+        centre + GridPeak(totals(fine_scores, counts), fine, o.fine_step_deg, &best);
     for (int a = 0; a < 3; ++a) samples[a].push_back(c[a]);
+    const size_t idx[3] = {best / (nfine * nfine), (best / nfine) % nfine, best % nfine};
+    bool border = false;
+    for (const size_t i : idx) border |= (i == 0 || i + 1 == nfine);
+    result.bootstrap_at_border += border ? 1 : 0;
   }
   for (int a = 0; a < 3; ++a) {
     if (samples[a].empty()) continue;
@@ -454,6 +477,7 @@ nlohmann::json EdgeAlignmentJson(const EdgeAlignmentResult& r, const EdgeAlignme
   body["calibration_error_deg"] = RotationJson(-r.correction_deg);
   body["correction_angle_deg"] = r.correction_deg.norm();
   body["bootstrap"] = {{"resamples", o.bootstrap},
+                       {"at_border", r.bootstrap_at_border},
                        {"std_deg", RotationJson(r.bootstrap_std_deg)},
                        {"p05_deg", RotationJson(r.bootstrap_p05_deg)},
                        {"p95_deg", RotationJson(r.bootstrap_p95_deg)}};

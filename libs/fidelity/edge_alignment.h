@@ -75,8 +75,9 @@ struct DepthEdges {
 };
 DepthEdges FindDepthEdges(const PointCloud& scan, const EdgeAlignmentOptions& options);
 
-// The image's edge fields (CV_32F, the size of the image): across vertical edges (u) and across
-// horizontal ones (v); `image` is 8-bit grey or colour.
+// The image's edge fields (CV_32F, the size of the image, unitless: saturated edges in [0, 1)
+// less their local mean): across vertical edges (u) and across horizontal ones (v); `image` is
+// 8-bit grey or colour (BGR).
 struct EdgeFields {
   cv::Mat across_u, across_v;
 };
@@ -109,10 +110,12 @@ struct EdgeAlignmentResult {
   Eigen::Vector3d bootstrap_std_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d bootstrap_p05_deg = Eigen::Vector3d::Zero();
   Eigen::Vector3d bootstrap_p95_deg = Eigen::Vector3d::Zero();
-  bool at_search_limit = false;  // The best coarse rotation lies on the grid's border.
-  // The edge field under the edge points, per unit of edge weight over all frames (grey levels
-  // per pixel), at calib.txt's extrinsic and at the corrected one; per frame (summed, not
-  // divided).
+  // Resamples whose best rotation lies on the fine grid's border (their spread is cut there).
+  int bootstrap_at_border = 0;
+  // The best coarse rotation lies on the grid's border, or the fine search stopped on its own.
+  bool at_search_limit = false;
+  // The edge fields under the edge points (unitless), per unit of edge weight over all frames,
+  // at calib.txt's extrinsic and at the corrected one; per frame (summed, not divided).
   double score_calibration = 0;
   double score_corrected = 0;
   std::vector<double> frame_score_calibration, frame_score_corrected;

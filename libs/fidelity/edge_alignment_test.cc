@@ -168,10 +168,6 @@ TEST(EdgeAlignment, DepthEdgesOutlineTheObjectsAndNotGrazingSurfaces) {
   // ... and none on the facade seen at a grazing angle or on the road between its rings.
   EXPECT_EQ(on_grazing_facade, 0);
   EXPECT_LE(on_road, 0.02 * static_cast<double>(edges.points.size()));
-  for (double w : edges.weights) {
-    EXPECT_GE(w, std::sqrt(o.min_discontinuity_m));
-    EXPECT_LE(w, std::sqrt(o.max_discontinuity_m));
-  }
 }
 
 // A facade 3 m to the left seen at 4-30 deg: the range between neighbouring returns grows by up
@@ -237,8 +233,6 @@ TEST(EdgeAlignment, FindsTheYawErrorOfTheCalibration) {
         AlignEdges(frames, written.Camera(0), written.CameraOffset(0), o, 2);
     SCOPED_TRACE(testing::Message() << "error " << error_deg.transpose());
     EXPECT_NEAR(r.correction_deg.y(), -error_deg.y(), 0.04);
-    EXPECT_GT(r.score_corrected, r.score_calibration - 1e-9);
-    EXPECT_EQ(r.frames, 10);
     EXPECT_GT(r.edge_points, 500);
     // The corrected calibration's optical axis points where the true one does, within what
     // pitch leaves open.
@@ -252,6 +246,26 @@ TEST(EdgeAlignment, FindsTheYawErrorOfTheCalibration) {
         std::atan2(axis_fixed.y(), axis_fixed.x()) - std::atan2(axis_true.y(), axis_true.x());
     EXPECT_LT(std::abs(yaw_off) / kDeg, 0.05);
   }
+}
+
+// Same frames and options, one or two threads: the same result to the last bit.
+TEST(EdgeAlignment, ResultDoesNotDependOnTheThreadCount) {
+  const Calibration truth = TrueCalibration();
+  EdgeAlignmentOptions o;
+  o.bootstrap = 30;
+  o.min_depth_m = 5;
+  o.search_deg = 0.3;
+  std::vector<AlignmentFrame> frames;
+  for (const double x : {0.0, 1.5, 3.0}) {
+    Scene view;
+    view.sensor_x = x;
+    frames.push_back(MakeAlignmentFrame(ScanOf(view), ImageOf(view, truth), truth, 0, o));
+  }
+  const EdgeAlignmentResult one =
+      AlignEdges(frames, truth.Camera(0), Eigen::Vector3d::Zero(), o, 1);
+  const EdgeAlignmentResult two =
+      AlignEdges(frames, truth.Camera(0), Eigen::Vector3d::Zero(), o, 2);
+  EXPECT_EQ(EdgeAlignmentJson(one, o).dump(), EdgeAlignmentJson(two, o).dump());
 }
 
 TEST(EdgeAlignment, ArtifactMatchesItsSchema) {

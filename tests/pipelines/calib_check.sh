@@ -21,11 +21,26 @@ seq="$out/data/sequences/00"
   { cat "$out/calib_check.log"; exit 1; }
 grep "calib_check:" "$out/calib_check.log" | tail -1
 test -s "$out/overlay.png" || { echo "calib_check: no overlay written" >&2; exit 1; }
+root=$(cd "$(dirname "$0")/../.." && pwd)
 python3 - "$seq/sim/scene.json" "$out/calib_check.json" "$seq/calib.txt" \
-  "$out/calib_corrected.txt" <<'PY'
+  "$out/calib_corrected.txt" "$root/schemas/calib_check.schema.json" <<'PY'
 import json, math, sys
 
-scene, result, written_path, corrected_path = sys.argv[1:5]
+scene, result, written_path, corrected_path, schema_path = sys.argv[1:6]
+
+# The artifact as written has every member its schema requires, rotations with their three axes.
+schema = json.load(open(schema_path))
+artifact = json.load(open(result))
+missing = [k for k in schema["required"] if k not in artifact]
+missing += [f"bootstrap.{k}" for k in schema["properties"]["bootstrap"]["required"]
+            if k not in artifact.get("bootstrap", {})]
+for key in ("correction_deg", "calibration_error_deg"):
+    missing += [f"{key}.{a}" for a in ("pitch_x", "yaw_y", "roll_z")
+                if a not in artifact.get(key, {})]
+if artifact.get("schema") != "calib_check" or missing:
+    raise SystemExit(f"calib_check: {result} does not match its schema (missing {missing})")
+if len(artifact["frame_score_calibration"]) != len(artifact["frames"]):
+    raise SystemExit("calib_check: one frame score per frame expected")
 
 
 def matmul(a, b):

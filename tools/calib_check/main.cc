@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -21,7 +20,6 @@
 #include "geometry/rigid3.h"
 #include "io/artifact.h"
 #include "io/dataset.h"
-#include "io/files.h"
 #include "io/kitti.h"
 #include "lidar/preprocess.h"
 
@@ -49,10 +47,7 @@ void WriteOverlay(const std::string& path, const cv::Mat& image,
       if (u >= 0 && v >= 0 && u < out.cols && v < out.rows) out.at<cv::Vec3b>(v, u) = colour;
     }
   }
-  jvl::io::AtomicWrite(path, [&](const std::string& tmp) {
-    JVL_CHECK(cv::imwrite(tmp + ".png", out), "cannot write " << path);
-    std::rename((tmp + ".png").c_str(), tmp.c_str());
-  });
+  jvl::io::WriteImage(path, out);
 }
 
 }  // namespace
@@ -66,7 +61,7 @@ int main(int argc, char** argv) {
       "and its spread by a bootstrap over the frames. Only the rotation is searched.");
   std::string dataset_dir, frames = ":", output, write_calib, overlay;
   jvl::io::DatasetOptions dataset_options;
-  int every = 1, camera = 0;
+  int every = 1, camera = 0, max_frames = 200;
   double vertical_correction_deg = 0;
   jvl::fidelity::EdgeAlignmentOptions options;
   CLI::App& cli = tool.cli();
@@ -77,6 +72,11 @@ int main(int argc, char** argv) {
   cli.add_option("--every", every, "Use every K-th frame of the range")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cli.add_option("--max-frames", max_frames,
+                 "Use at most this many frames, spread evenly over the range (each keeps two "
+                 "image-sized fields, 3.7 MB for a KITTI image); 0 = every selected frame")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cli.add_option("--camera", camera, jvl::io::kCameraHelp)->capture_default_str();
   tool.OutputFile(
       cli.add_option("-o,--output", output, "Output JSON (calib_check artifact)")->required());
@@ -122,10 +122,22 @@ int main(int argc, char** argv) {
     tool.AddDataset(*dataset, dataset_dir);
     dataset->CheckCamera(camera);
     const jvl::Calibration& calibration = dataset->calibration();
-    std::vector<int64_t> used;
+    std::vector<int64_t> selected;
     for (size_t i = 0; i < dataset->frames().size(); i += static_cast<size_t>(every))
-      used.push_back(dataset->frames()[i]);
-    JVL_CHECK(!used.empty(), "calib_check: no frame in the range");
+      selected.push_back(dataset->frames()[i]);
+    JVL_CHECK(!selected.empty(), "calib_check: no frame in the range");
+    std::vector<int64_t> used = selected;
+    if (max_frames > 0 && selected.size() > static_cast<size_t>(max_frames)) {
+      // Evenly spread: frame k * n / max_frames of the selection, k = 0 .. max_frames - 1.
+      used.clear();
+      for (int k = 0; k < max_frames; ++k)
+        used.push_back(
+            selected[static_cast<size_t>(k) * selected.size() / static_cast<size_t>(max_frames)]);
+      spdlog::info(
+          "calib_check: {} of the {} selected frames, spread evenly over the range (--max-frames "
+          "{}; 0 takes them all, at 3.7 MB each for a KITTI image)",
+          used.size(), selected.size(), max_frames);
+    }
     std::vector<jvl::fidelity::AlignmentFrame> aligned(used.size());
     jvl::Progress progress("frames", static_cast<int64_t>(used.size()), !tool.quiet());
     jvl::ParallelFor(static_cast<int64_t>(used.size()), tool.threads(), [&](int64_t i) {
@@ -151,6 +163,11 @@ int main(int argc, char** argv) {
     if (!overlay.empty())
       WriteOverlay(overlay, dataset->LoadImage(used[0], camera), aligned[0],
                    calibration.Camera(camera), calibration.CameraOffset(camera), r.correction_deg);
+    if (options.bootstrap > 0 && r.bootstrap_at_border * 20 > options.bootstrap)
+      spdlog::warn(
+          "calib_check: {} of {} bootstrap resamples found their best rotation on the border of "
+          "the fine grid: the spread given is cut there and is too small",
+          r.bootstrap_at_border, options.bootstrap);
     if (r.at_search_limit)
       spdlog::warn(
           "calib_check: the best rotation lies at the border of the search (+-{} deg): the "
