@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -11,6 +12,7 @@
 #include <unordered_map>
 
 #include "core/check.h"
+#include "core/statistics.h"
 #include "core/threads.h"
 #include "geometry/angles.h"
 #include "geometry/rigid3.h"
@@ -40,13 +42,15 @@ double ParabolaPeak(double a, double b, double c) {
   return std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
 }
 
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(pos));
-  const size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+// Grid point g of a cubic grid with n points per axis as its index per axis (x, y, z): g =
+// (i * n + j) * n + k.
+std::array<size_t, 3> GridIndex(size_t g, size_t n) { return {g / (n * n), (g / n) % n, g % n}; }
+
+// Whether grid point g lies on the grid's border along some axis.
+bool OnGridBorder(size_t g, size_t n) {
+  for (const size_t i : GridIndex(g, n))
+    if (i == 0 || i + 1 == n) return true;
+  return false;
 }
 
 // The best of a cubic grid of scores (index = (i * n + j) * n + k over the axes x, y, z) with
@@ -58,15 +62,17 @@ Eigen::Vector3d GridPeak(const std::vector<double>& scores, const std::vector<do
   for (size_t g = 1; g < scores.size(); ++g)
     if (scores[g] > scores[best]) best = g;  // Ties: the lowest index (deterministic).
   if (best_index) *best_index = best;
-  const size_t idx[3] = {best / (n * n), (best / n) % n, best % n};
+  const std::array<size_t, 3> idx = GridIndex(best, n);
   Eigen::Vector3d peak;
   for (int axis = 0; axis < 3; ++axis) {
     double sub = 0.0;
     if (idx[axis] > 0 && idx[axis] + 1 < n) {
-      size_t lo[3] = {idx[0], idx[1], idx[2]}, hi[3] = {idx[0], idx[1], idx[2]};
+      std::array<size_t, 3> lo = idx, hi = idx;
       --lo[axis];
       ++hi[axis];
-      auto at = [&](const size_t* i) { return scores[(i[0] * n + i[1]) * n + i[2]]; };
+      auto at = [&](const std::array<size_t, 3>& i) {
+        return scores[(i[0] * n + i[1]) * n + i[2]];
+      };
       sub = ParabolaPeak(at(lo), scores[best], at(hi));
     }
     peak[axis] = offsets[idx[axis]] + sub * step;
@@ -308,8 +314,8 @@ double FrameScore(const AlignmentFrame& frame, const Eigen::Matrix3d& rotation,
   // Bilinear value of f at the projection of x, or NaN outside the image.
   auto sample = [&](const cv::Mat& f, const Eigen::Vector3d& x) {
     if (x.z() <= 0) return std::numeric_limits<double>::quiet_NaN();
-    const double u = camera.fx * x.x() / x.z() + camera.cx;
-    const double v = camera.fy * x.y() / x.z() + camera.cy;
+    const Eigen::Vector2d uv = camera.Project(x);
+    const double u = uv.x(), v = uv.y();
     if (!(u >= 0 && v >= 0 && u < cols - 1 && v < rows - 1))
       return std::numeric_limits<double>::quiet_NaN();
     const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
@@ -347,8 +353,9 @@ EdgeAlignmentResult AlignEdges(const std::vector<AlignmentFrame>& frames,
     std::vector<double> per_frame(n * n * n * nf);
     ParallelFor(static_cast<int64_t>(n * n * n), threads, [&](int64_t g) {
       const size_t gi = static_cast<size_t>(g);
+      const std::array<size_t, 3> idx = GridIndex(gi, n);
       const Eigen::Vector3d deg =
-          centre + Eigen::Vector3d(offsets[gi / (n * n)], offsets[(gi / n) % n], offsets[gi % n]);
+          centre + Eigen::Vector3d(offsets[idx[0]], offsets[idx[1]], offsets[idx[2]]);
       const Eigen::Matrix3d r = RotationOfDeg(deg);
       for (size_t f = 0; f < nf; ++f)
         per_frame[gi * nf + f] = FrameScore(frames[f], r, camera, camera_offset);
@@ -376,7 +383,7 @@ EdgeAlignmentResult AlignEdges(const std::vector<AlignmentFrame>& frames,
     for (int axis = 0; axis < 3 && at_zero != 0; ++axis) {
       std::string line;
       for (size_t i = 0; i < n; ++i) {
-        size_t idx[3] = {c, c, c};
+        std::array<size_t, 3> idx = {c, c, c};
         idx[axis] = i;
         line += fmt::format(
             " {:+.1f}",
@@ -386,14 +393,10 @@ EdgeAlignmentResult AlignEdges(const std::vector<AlignmentFrame>& frames,
                     names[axis], coarse.front(), coarse.back(), line);
     }
   }
-  {
-    const size_t n = coarse.size();
-    const size_t idx[3] = {coarse_best / (n * n), (coarse_best / n) % n, coarse_best % n};
-    for (const size_t i : idx) result.at_search_limit |= (i == 0 || i + 1 == n);
-  }
-  const Eigen::Vector3d coarse_centre(coarse[coarse_best / (coarse.size() * coarse.size())],
-                                      coarse[(coarse_best / coarse.size()) % coarse.size()],
-                                      coarse[coarse_best % coarse.size()]);
+  result.at_search_limit = OnGridBorder(coarse_best, coarse.size());
+  const std::array<size_t, 3> coarse_idx = GridIndex(coarse_best, coarse.size());
+  const Eigen::Vector3d coarse_centre(coarse[coarse_idx[0]], coarse[coarse_idx[1]],
+                                      coarse[coarse_idx[2]]);
   // The fine grid within one coarse step of the best coarse rotation; while its best lies on
   // its border (the coarse grid can miss a peak narrower than its step), moved there.
   const std::vector<double> fine = GridOffsets(o.coarse_step_deg, o.fine_step_deg);
@@ -404,9 +407,8 @@ EdgeAlignmentResult AlignEdges(const std::vector<AlignmentFrame>& frames,
     fine_scores = score_grid(centre, fine);
     size_t best = 0;
     const Eigen::Vector3d peak = GridPeak(totals(fine_scores, all), fine, o.fine_step_deg, &best);
-    const size_t idx[3] = {best / (nfine * nfine), (best / nfine) % nfine, best % nfine};
-    bool border = false;
-    for (const size_t i : idx) border |= (i == 0 || i + 1 == nfine);
+    const std::array<size_t, 3> idx = GridIndex(best, nfine);
+    const bool border = OnGridBorder(best, nfine);
     const Eigen::Vector3d moved =
         centre + Eigen::Vector3d(fine[idx[0]], fine[idx[1]], fine[idx[2]]);
     if (!border || move == 5 || moved.cwiseAbs().maxCoeff() > o.search_deg + 1e-9) {
@@ -428,10 +430,7 @@ EdgeAlignmentResult AlignEdges(const std::vector<AlignmentFrame>& frames,
     const Eigen::Vector3d c =
         centre + GridPeak(totals(fine_scores, counts), fine, o.fine_step_deg, &best);
     for (int a = 0; a < 3; ++a) samples[a].push_back(c[a]);
-    const size_t idx[3] = {best / (nfine * nfine), (best / nfine) % nfine, best % nfine};
-    bool border = false;
-    for (const size_t i : idx) border |= (i == 0 || i + 1 == nfine);
-    result.bootstrap_at_border += border ? 1 : 0;
+    result.bootstrap_at_border += OnGridBorder(best, nfine) ? 1 : 0;
   }
   for (int a = 0; a < 3; ++a) {
     if (samples[a].empty()) continue;

@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
   std::string dataset_dir, frames = ":", output, write_calib, overlay;
   jvl::io::DatasetOptions dataset_options;
   int every = 1, camera = 0, max_frames = 200;
-  double vertical_correction_deg = 0;
+  jvl::lidar::PreprocessOptions preprocess;  // Only its vertical correction is used.
   jvl::fidelity::EdgeAlignmentOptions options;
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
       "Also write the first frame's image as a PNG with its LiDAR edge points at calib.txt's Tr "
       "(red) and at the corrected one (green)"));
   jvl::app::OptionGroup edges(tool, "Edges");
-  edges.Add("--vertical-correction", vertical_correction_deg,
+  edges.Add("--vertical-correction", "vertical_correction_deg", preprocess.vertical_correction_deg,
             "Raise every return's elevation by this before the check (deg; the KITTI HDL-64's "
             "elevation error, 0.205, as lidar_odom's option of that name; 0 = off)");
   edges.Add("--min-discontinuity", "min_discontinuity_m", options.min_discontinuity_m,
@@ -113,9 +113,7 @@ int main(int argc, char** argv) {
 
   return tool.Run(argc, argv, [&] {
     options.Check();
-    JVL_CHECK(
-        std::abs(vertical_correction_deg) < 5,
-        "--vertical-correction must be a small angle in degrees, got " << vertical_correction_deg);
+    preprocess.Check();
     cv::setNumThreads(1);  // Parallelism is over frames and rotations.
     const auto dataset =
         jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
@@ -142,8 +140,9 @@ int main(int argc, char** argv) {
     jvl::Progress progress("frames", static_cast<int64_t>(used.size()), !tool.quiet());
     jvl::ParallelFor(static_cast<int64_t>(used.size()), tool.threads(), [&](int64_t i) {
       jvl::PointCloud scan = dataset->LoadScan(used[i]);
-      if (vertical_correction_deg != 0)
-        jvl::lidar::CorrectVerticalAngle(vertical_correction_deg * M_PI / 180.0, &scan.points);
+      if (preprocess.vertical_correction_deg != 0)
+        jvl::lidar::CorrectVerticalAngle(preprocess.vertical_correction_deg * M_PI / 180.0,
+                                         &scan.points);
       aligned[i] = jvl::fidelity::MakeAlignmentFrame(scan, dataset->LoadImage(used[i], camera),
                                                      calibration, camera, options);
       progress.Tick();
@@ -154,7 +153,7 @@ int main(int argc, char** argv) {
     nlohmann::json body = jvl::fidelity::EdgeAlignmentJson(r, options);
     body["frames"] = used;
     body["camera"] = camera;
-    body["vertical_correction_deg"] = vertical_correction_deg;
+    body["vertical_correction_deg"] = preprocess.vertical_correction_deg;
     const int better = body["frames_better"].get<int>();
     jvl::io::WriteJsonArtifact(output, "calib_check", 1, body, tool.MakeProvenance());
     if (!write_calib.empty())
