@@ -475,11 +475,80 @@ std::vector<T> H5Reader::ReadArray(const std::string& name, int64_t expected_col
   return out;
 }
 
+template <typename T>
+std::vector<T> H5Reader::ReadRows(const std::string& name,
+                                  const std::vector<std::pair<int64_t, int64_t>>& ranges,
+                                  int64_t expected_cols) const {
+  const auto dims = Dims(name);
+  JVL_CHECK(!dims.empty() && dims.size() <= 2,
+            impl_->path << ": dataset '" << name << "' is not a 1-D or 2-D array");
+  if (expected_cols > 0) {
+    JVL_CHECK(dims.size() == 2 && dims[1] == expected_cols,
+              impl_->path << ": dataset '" << name << "' should be N x " << expected_cols);
+  }
+  const int64_t cols = dims.size() == 2 ? dims[1] : 1;
+  int64_t rows = 0, end = 0;
+  for (const auto& [first, last] : ranges) {
+    JVL_CHECK(first >= end && first <= last && last <= dims[0],
+              impl_->path << ": rows [" << first << ", " << last << ") of dataset '" << name
+                          << "' (" << dims[0] << " rows) are out of order or out of range");
+    rows += last - first;
+    end = last;
+  }
+  std::vector<T> out(static_cast<size_t>(rows * cols));
+  if (out.empty()) return out;
+  Handle ds(H5Dopen2(impl_->file, name.c_str(), H5P_DEFAULT), H5Dclose);
+  JVL_CHECK(ds.ok(), impl_->path << ": cannot open dataset '" << name << "' (damaged file?)");
+  // As in ReadArray: unchunked data must store every value of its declared shape.
+  Handle plist(H5Dget_create_plist(ds.get()), H5Pclose);
+  Handle type(H5Dget_type(ds.get()), H5Tclose);
+  JVL_CHECK(plist.ok() && type.ok(),
+            impl_->path << ": cannot read the layout of dataset '" << name << "' (damaged file?)");
+  const H5D_layout_t layout = H5Pget_layout(plist.get());
+  JVL_CHECK(
+      layout == H5D_CONTIGUOUS || layout == H5D_CHUNKED || layout == H5D_COMPACT,
+      impl_->path << ": dataset '" << name << "' has an unknown storage layout (damaged file?)");
+  if (layout != H5D_CHUNKED) {
+    const uint64_t stored = H5Dget_storage_size(ds.get());
+    const uint64_t needed = static_cast<uint64_t>(dims[0] * cols) * H5Tget_size(type.get());
+    JVL_CHECK(stored == needed, impl_->path << ": dataset '" << name << "' stores " << stored
+                                            << " bytes for " << dims[0] * cols << " values of "
+                                            << H5Tget_size(type.get()) << " bytes (damaged file?)");
+  }
+  Handle file_space(H5Dget_space(ds.get()), H5Sclose);
+  JVL_CHECK(file_space.ok(), impl_->path << ": cannot read the shape of '" << name << "'");
+  size_t offset = 0;
+  for (const auto& [first, last] : ranges) {
+    if (first == last) continue;
+    const hsize_t start[2] = {static_cast<hsize_t>(first), 0};
+    const hsize_t count[2] = {static_cast<hsize_t>(last - first), static_cast<hsize_t>(cols)};
+    const int rank = static_cast<int>(dims.size());
+    Handle memory(H5Screate_simple(rank, count, nullptr), H5Sclose);
+    JVL_CHECK(memory.ok() && H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr,
+                                                 count, nullptr) >= 0,
+              impl_->path << ": cannot select rows of dataset '" << name << "'");
+    JVL_CHECK(H5Dread(ds.get(), NativeType<T>(), memory.get(), file_space.get(), H5P_DEFAULT,
+                      out.data() + offset) >= 0,
+              impl_->path << ": cannot read dataset '" << name << "' (damaged file?)");
+    offset += static_cast<size_t>((last - first) * cols);
+  }
+  return out;
+}
+
 template std::vector<double> H5Reader::ReadArray<double>(const std::string&, int64_t) const;
 template std::vector<float> H5Reader::ReadArray<float>(const std::string&, int64_t) const;
 template std::vector<int64_t> H5Reader::ReadArray<int64_t>(const std::string&, int64_t) const;
 template std::vector<int32_t> H5Reader::ReadArray<int32_t>(const std::string&, int64_t) const;
 template std::vector<uint8_t> H5Reader::ReadArray<uint8_t>(const std::string&, int64_t) const;
+#define JVL_READ_ROWS(T)                         \
+  template std::vector<T> H5Reader::ReadRows<T>( \
+      const std::string&, const std::vector<std::pair<int64_t, int64_t>>&, int64_t) const;
+JVL_READ_ROWS(double)
+JVL_READ_ROWS(float)
+JVL_READ_ROWS(int64_t)
+JVL_READ_ROWS(int32_t)
+JVL_READ_ROWS(uint8_t)
+#undef JVL_READ_ROWS
 
 std::string H5Reader::ReadString(const std::string& name) const {
   const auto [parent, leaf] = SplitParent(name);

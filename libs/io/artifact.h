@@ -14,6 +14,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/files.h"
@@ -21,10 +22,10 @@
 namespace jvl::io {
 
 struct Provenance {
-  std::string tool;                 // e.g. "lidar_odom"
+  std::string tool;                                   // e.g. "lidar_odom"
   nlohmann::json options = nlohmann::json::object();  // Every option with its value.
   std::vector<FileInfo> inputs;
-  std::string dataset_id;           // Identifies the sequence (see Dataset::id()).
+  std::string dataset_id;  // Identifies the sequence (see Dataset::id()).
   double wall_time_s = 0;
   int64_t peak_memory_bytes = 0;
   // Adds version, git revision and the UTC creation time.
@@ -81,6 +82,12 @@ class H5Reader {
   // Reads a dataset converting to T; `expected_cols` > 0 checks a 2-D shape (N x cols).
   template <typename T>
   std::vector<T> ReadArray(const std::string& name, int64_t expected_cols = 0) const;
+  // Reads only the rows [first, last) of each of `ranges` (ascending, not overlapping, within the
+  // dataset) one after another: the chunks no range touches are not decompressed.
+  template <typename T>
+  std::vector<T> ReadRows(const std::string& name,
+                          const std::vector<std::pair<int64_t, int64_t>>& ranges,
+                          int64_t expected_cols = 0) const;
   std::string ReadString(const std::string& name) const;
   nlohmann::json ReadJson(const std::string& name) const;
   std::string schema() const;

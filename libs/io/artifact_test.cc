@@ -73,6 +73,40 @@ TEST_F(ArtifactTest, ArraysAttributesAndProvenanceRoundTrip) {
   EXPECT_THROW(r.ReadArray<double>("group/sub/values", 4), Error);
 }
 
+// Rows of a chunked (compressed) and of a contiguous array read range by range equal the same
+// rows of the whole array; ranges out of order or beyond the array are refused.
+TEST_F(ArtifactTest, ReadRowsReadsTheRangesOfChunkedAndContiguousArrays) {
+  std::vector<int32_t> big(3 * 100000), small(3 * 10);
+  for (size_t i = 0; i < big.size(); ++i) big[i] = static_cast<int32_t>(7 * i + 1);
+  for (size_t i = 0; i < small.size(); ++i) small[i] = static_cast<int32_t>(i);
+  {
+    H5Writer w(Path("rows.h5"), "demo", 1);
+    w.WriteArray("big", big, {100000, 3});  // Chunked: five chunks of 21845 rows.
+    w.WriteArray("small", small, {10, 3});  // Contiguous.
+    w.Commit(Provenance{});
+  }
+  H5Reader r(Path("rows.h5"), "demo", 1);
+  auto expected = [](const std::vector<int32_t>& all,
+                     const std::vector<std::pair<int64_t, int64_t>>& ranges) {
+    std::vector<int32_t> out;
+    for (const auto& [first, last] : ranges)
+      out.insert(out.end(), all.begin() + 3 * first, all.begin() + 3 * last);
+    return out;
+  };
+  const std::vector<std::pair<int64_t, int64_t>> ranges = {
+      {0, 2}, {5, 5}, {21830, 21870}, {60000, 60001}, {99990, 100000}};
+  EXPECT_EQ(r.ReadRows<int32_t>("big", ranges, 3), expected(big, ranges));
+  EXPECT_EQ(r.ReadRows<int32_t>("small", {{1, 3}, {9, 10}}, 3), expected(small, {{1, 3}, {9, 10}}));
+  EXPECT_TRUE(r.ReadRows<int32_t>("big", {}, 3).empty());
+  EXPECT_NE(ErrorOf([&] {
+              r.ReadRows<int32_t>("big", {{5, 9}, {2, 3}}, 3);
+            }).find("out of order or out of range"),
+            std::string::npos);
+  EXPECT_THROW(r.ReadRows<int32_t>("big", {{99999, 100001}}, 3), Error);
+  EXPECT_THROW(r.ReadRows<int32_t>("big", {{3, 2}}, 3), Error);
+  EXPECT_THROW(r.ReadRows<int32_t>("big", {{0, 1}}, 4), Error);
+}
+
 TEST_F(ArtifactTest, SchemaMismatchNamesFileExpectedAndFound) {
   WriteTrajectoryArtifact(Path("t.h5"), Small(), Provenance{});
   const std::string msg = ErrorOf([&] { H5Reader(Path("t.h5"), "vps", 1); });

@@ -3,7 +3,10 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <utility>
 
 #include "core/check.h"
 #include "io/camera_io.h"
@@ -166,6 +169,44 @@ VisualMapData ReadVisualMap(const std::string& path) {
   d.covisibility_weight = r.ReadArray<int32_t>("covisibility/weight");
   d.prior = ReadTrajectoryGroup(r, "prior");
   d.summary = r.ReadJson("summary");
+  d.Check(path);
+  return d;
+}
+
+VisualMapData ReadVisualKeypoints(const std::string& path, const std::vector<int64_t>& frames) {
+  H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
+  VisualMapData d;
+  d.camera = ReadCameraArray(r, "camera");
+  ReadHeader(r, path, &d);
+  d.keyframes.Check((path + ": keyframes").c_str());
+  const std::vector<int32_t> keyframe_of = r.ReadArray<int32_t>("keypoints/keyframe");
+  CheckIndices(keyframe_of, d.keyframes.size(), "keypoints/keyframe", path);
+  // Rows [first, last) of each keyframe row; a keyframe's keypoints are contiguous.
+  std::vector<std::pair<int64_t, int64_t>> rows_of(d.keyframes.size(), {-1, -1});
+  for (size_t p = 0; p < keyframe_of.size(); ++p) {
+    auto& rows = rows_of[static_cast<size_t>(keyframe_of[p])];
+    const auto row = static_cast<int64_t>(p);
+    JVL_CHECK(rows.first < 0 || rows.second == row,
+              path << ": keypoints of keyframe row " << keyframe_of[p]
+                   << " are not contiguous (row " << p << ")");
+    if (rows.first < 0) rows.first = row;
+    rows.second = row + 1;
+  }
+  std::vector<std::pair<int64_t, int64_t>> wanted;
+  for (const int64_t f : frames) {
+    const std::optional<size_t> k = d.keyframes.IndexOf(f);
+    if (k && rows_of[*k].first >= 0) wanted.push_back(rows_of[*k]);
+  }
+  std::sort(wanted.begin(), wanted.end());
+  wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+  for (const auto& [first, last] : wanted) {
+    d.keypoint_keyframe.insert(d.keypoint_keyframe.end(), keyframe_of.begin() + first,
+                               keyframe_of.begin() + last);
+  }
+  d.keypoint_uv = r.ReadRows<float>("keypoints/uv", wanted, 2);
+  d.keypoint_octave = r.ReadRows<int32_t>("keypoints/octave", wanted);
+  d.keypoint_angle = r.ReadRows<float>("keypoints/angle", wanted);
+  d.keypoint_descriptor = r.ReadRows<uint8_t>("keypoints/descriptor", wanted, 32);
   d.Check(path);
   return d;
 }

@@ -70,5 +70,10 @@ VisualMapData ReadVisualMap(const std::string& path);
 // Only camera_choice, scale_factor, num_levels and keyframes of a visual map, the rest left empty
 // (a fraction of a second where the whole map can take seconds).
 VisualMapData ReadVisualMapHeader(const std::string& path);
+// The header, the camera and the keypoints of the keyframes at `frames` (frames the map lacks are
+// skipped), in the map's row order; map points, observations, covisibility and the prior stay
+// empty. Only the chunks of keypoints/* holding those rows are decompressed, so a few keyframes of
+// a large map are read in a fraction of the whole map's time.
+VisualMapData ReadVisualKeypoints(const std::string& path, const std::vector<int64_t>& frames);
 
 }  // namespace jvl::io

@@ -102,6 +102,52 @@ TEST(VisualIo, HeaderIsTheMapsHead) {
   fs::remove(path);
 }
 
+// The keypoints of some keyframes equal their rows of the whole map; frames the map lacks are
+// skipped and the rest of the map is not read.
+TEST(VisualIo, KeypointsOfSomeKeyframesAreTheirRowsOfTheWholeMap) {
+  const std::string path = TempPath("kp.h5").string();
+  WriteVisualMap(path, MakeMap(), Provenance{});
+  const VisualMapData whole = ReadVisualMap(path);
+  const VisualMapData some = ReadVisualKeypoints(path, {5, 4});  // Frame 4 is no keyframe.
+  EXPECT_EQ(some.keyframes.frames, whole.keyframes.frames);
+  EXPECT_EQ(some.camera.K(), whole.camera.K());
+  EXPECT_EQ(some.keypoint_keyframe, (std::vector<int32_t>{1, 1, 1}));
+  EXPECT_EQ(some.keypoint_uv,
+            std::vector<float>(whole.keypoint_uv.begin() + 6, whole.keypoint_uv.end()));
+  EXPECT_EQ(some.keypoint_octave,
+            std::vector<int32_t>(whole.keypoint_octave.begin() + 3, whole.keypoint_octave.end()));
+  EXPECT_EQ(some.keypoint_angle,
+            std::vector<float>(whole.keypoint_angle.begin() + 3, whole.keypoint_angle.end()));
+  EXPECT_EQ(some.keypoint_descriptor,
+            std::vector<uint8_t>(whole.keypoint_descriptor.begin() + 3 * 32,
+                                 whole.keypoint_descriptor.end()));
+  EXPECT_TRUE(some.mappoint_position.empty());
+  EXPECT_TRUE(some.observation_keyframe.empty());
+  const VisualMapData both = ReadVisualKeypoints(path, {5, 3});
+  EXPECT_EQ(both.keypoint_keyframe, whole.keypoint_keyframe);
+  EXPECT_EQ(both.keypoint_descriptor, whole.keypoint_descriptor);
+  EXPECT_TRUE(ReadVisualKeypoints(path, {}).keypoint_keyframe.empty());
+  fs::remove(path);
+}
+
+// Keypoints of one keyframe split by another's are refused with the keyframe named.
+TEST(VisualIo, KeypointsOfAKeyframeMustBeContiguous) {
+  VisualMapData d = MakeMap();
+  d.keypoint_keyframe = {0, 1, 0, 1, 1, 1};
+  d.observation_keypoint = {0, 1, 2, 3};  // Still of the keyframes they name.
+  d.observation_keyframe = {0, 1, 0, 1};
+  const std::string path = TempPath("split.h5").string();
+  WriteVisualMap(path, d, Provenance{});
+  try {
+    ReadVisualKeypoints(path, {3});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(e.message().find("keyframe row 0 are not contiguous"), std::string::npos)
+        << e.message();
+  }
+  fs::remove(path);
+}
+
 // The camera choice of a map built from another camera is kept; a camera-0 map has none written.
 TEST(VisualIo, CameraChoiceRoundTrip) {
   const std::string path = TempPath("cam.h5").string();

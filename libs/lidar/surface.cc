@@ -12,19 +12,25 @@
 namespace jvl::lidar {
 namespace {
 
-// Local PCA of point i's neighbourhood: normal = eigenvector of the smallest eigenvalue,
-// planarity a2D = (s2 - s3) / s1 (IMLS-SLAM Sec. V).
-void FitLocalPlane(const std::vector<Eigen::Vector3d>& points,
-                   const std::vector<std::pair<double, int>>& nn, int i, ScanSurface* s) {
+// Local PCA of point i's neighbourhood nn[0, count): normal = eigenvector of the smallest
+// eigenvalue, planarity a2D = (s2 - s3) / s1 (IMLS-SLAM Sec. V). The covariance is summed in six
+// scalars (the same products and sums as the outer products d d^T, which the compiler spilled
+// through the stack on every neighbour).
+void FitLocalPlane(const std::vector<Eigen::Vector3d>& points, const std::pair<double, int>* nn,
+                   size_t count, int i, ScanSurface* s) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& e : nn) mean += points[e.second];
-  mean /= static_cast<double>(nn.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& e : nn) {
-    const Eigen::Vector3d d = points[e.second] - mean;
-    cov += d * d.transpose();
+  for (size_t j = 0; j < count; ++j) mean += points[nn[j].second];
+  mean /= static_cast<double>(count);
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  for (size_t j = 0; j < count; ++j) {
+    const Eigen::Vector3d& p = points[nn[j].second];
+    const double dx = p.x() - mean.x(), dy = p.y() - mean.y(), dz = p.z() - mean.z();
+    xx += dx * dx, xy += dx * dy, xz += dx * dz;
+    yy += dy * dy, yz += dy * dz, zz += dz * dz;
   }
-  cov /= static_cast<double>(nn.size());
+  Eigen::Matrix3d cov;
+  cov << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  cov /= static_cast<double>(count);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
   eig.computeDirect(cov);
   // Eigenvalues ascending: lambda3 <= lambda2 <= lambda1.
@@ -69,7 +75,8 @@ ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
       ys[c] = points[cand[c]].y();
       zs[c] = points[cand[c]].z();
     }
-    std::vector<std::pair<double, int>> nn;
+    // The k nearest, sorted by (distance, index), as a fixed array filled field by field.
+    std::vector<std::pair<double, int>> nn(k);
     for (const int i : members) {
       const double px = points[i].x(), py = points[i].y(), pz = points[i].z();
       for (size_t c = 0; c < n; ++c) {
@@ -78,20 +85,26 @@ ScanSurface ComputeSurface(const std::vector<Eigen::Vector3d>& points,
       }
       // The k nearest within the radius, kept sorted by (distance, index) - a strict order, so
       // the set is deterministic - by insertion (k is small; cheaper than a partition).
-      nn.clear();
+      size_t count = 0;
       for (size_t c = 0; c < n; ++c) {
-        if (d2[c] > r2) continue;
-        const std::pair<double, int> e(d2[c], cand[c]);
-        if (nn.size() == k) {
-          if (!(e < nn.back())) continue;
-          nn.pop_back();
+        const double d = d2[c];
+        if (d > r2) continue;
+        const int index = cand[c];
+        auto before = [&](const std::pair<double, int>& e) {
+          return d < e.first || (d == e.first && index < e.second);
+        };
+        if (count == k) {
+          if (!before(nn[k - 1])) continue;
+          --count;
         }
         // Into place from the back (mostly few steps: the nearer cells come first).
-        nn.push_back(e);
-        for (size_t m = nn.size() - 1; m > 0 && e < nn[m - 1]; --m) std::swap(nn[m], nn[m - 1]);
+        size_t m = count++;
+        for (; m > 0 && before(nn[m - 1]); --m) nn[m] = nn[m - 1];
+        nn[m].first = d;
+        nn[m].second = index;
       }
-      if (nn.size() < static_cast<size_t>(options.min_normal_neighbors)) continue;
-      FitLocalPlane(points, nn, i, &s);
+      if (count < static_cast<size_t>(options.min_normal_neighbors)) continue;
+      FitLocalPlane(points, nn.data(), count, i, &s);
     }
   });
   return s;

@@ -128,12 +128,31 @@ SparseDepth ToSparse(const cv::Mat& depth) {
   return sparse;
 }
 
-cv::Mat FromSparse(const SparseDepth& sparse, int rows, int cols) {
-  cv::Mat depth(rows, cols, CV_32F, cv::Scalar(0));
-  float* data = depth.ptr<float>(0);
-  for (const auto& [index, z] : sparse) data[index] = z;
-  return depth;
-}
+// The image rebuilt from a sparse depth in a buffer of the calling thread (an image of its own
+// per candidate cost a megabyte or two of fresh, zeroed pages each time), zeroed again when the
+// guard goes out of scope.
+class DenseDepth {
+ public:
+  DenseDepth(const SparseDepth& sparse, int rows, int cols) : sparse_(sparse) {
+    thread_local cv::Mat buffer;
+    if (buffer.rows != rows || buffer.cols != cols || buffer.type() != CV_32F)
+      buffer = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
+    image_ = buffer;
+    float* data = image_.ptr<float>(0);
+    for (const auto& [index, z] : sparse_) data[index] = z;
+  }
+  ~DenseDepth() {
+    float* data = image_.ptr<float>(0);
+    for (const auto& entry : sparse_) data[entry.first] = 0;
+  }
+  DenseDepth(const DenseDepth&) = delete;
+  DenseDepth& operator=(const DenseDepth&) = delete;
+  const cv::Mat& image() const { return image_; }
+
+ private:
+  const SparseDepth& sparse_;
+  cv::Mat image_;  // Shares the thread's buffer.
+};
 
 // The depth of the latest match keyframes (sparse), shared by the threads verifying candidates
 // (a match keyframe of one lap is the match of the queries of every later lap).
@@ -185,10 +204,13 @@ LoopCandidate MatchVisualCandidate(const VisualKeyframe& query, const VisualKeyf
     depth = ScanDepth(scans.Load(match_frame), calibration, camera, choice.offset);
     return ToSparse(depth);
   };
+  std::shared_ptr<const SparseDepth> kept;
+  std::optional<DenseDepth> dense;
   if (!depths) {
     project();
-  } else if (const auto kept = depths->Get(match_frame, project); depth.empty()) {
-    depth = FromSparse(*kept, camera.height, camera.width);
+  } else if (kept = depths->Get(match_frame, project); depth.empty()) {
+    dense.emplace(*kept, camera.height, camera.width);
+    depth = dense->image();
   }
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> image;

@@ -276,15 +276,16 @@ int main(int argc, char** argv) {
                             << visual_options.orb.num_levels << " x "
                             << visual_options.orb.scale_factor);
       dataset->CheckCamera(visual_options.camera);
-      std::vector<int64_t> missing;
+      std::vector<int64_t> missing, present;
       for (const int64_t f : keyframes.frames)
-        if (!header.keyframes.IndexOf(f)) missing.push_back(f);
-      // A thread of its own reads the map (HDF5 is read by one thread at a time) while the
-      // worker threads extract (reading is mostly waiting on inflate and the disk, so the
-      // threads overlap). A map that cannot be read is reported after the extraction; an image
-      // that cannot be read first (the future's destructor waits for the reader).
+        (header.keyframes.IndexOf(f) ? present : missing).push_back(f);
+      // A thread of its own reads the keypoints of the keyframes the map holds (only those rows:
+      // HDF5 is read by one thread at a time) while the worker threads extract. A map that cannot
+      // be read is reported after the extraction; an image that cannot be read first (the future's
+      // destructor waits for the reader).
       std::vector<vision::OrbFeatures> features(missing.size());
-      auto reading = std::async(std::launch::async, [&] { return io::ReadVisualMap(visual_path); });
+      auto reading = std::async(std::launch::async,
+                                [&] { return io::ReadVisualKeypoints(visual_path, present); });
       ParallelFor(static_cast<int64_t>(missing.size()), tool.threads(), [&](int64_t i) {
         features[static_cast<size_t>(i)] = vision::ExtractOrb(
             dataset->LoadImage(missing[static_cast<size_t>(i)], visual_options.camera),
@@ -298,12 +299,6 @@ int main(int argc, char** argv) {
       } catch (const Error& e) {
         JVL_THROW(visual_path << ": " << e.what());
       }
-      // Only the keypoints are needed.
-      auto release = [](auto& v) { std::decay_t<decltype(v)>().swap(v); };
-      release(map.mappoint_position), release(map.mappoint_descriptor);
-      release(map.mappoint_normal), release(map.observation_keyframe);
-      release(map.observation_keypoint), release(map.observation_mappoint);
-      release(map.covisibility_edges), release(map.covisibility_weight);
     }
     // The camera is checked before any detector's work.
     if (use_visual) dataset->CheckCamera(visual_options.camera);
