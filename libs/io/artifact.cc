@@ -431,6 +431,30 @@ std::vector<std::string> H5Reader::ListAttributes() const {
   return names;
 }
 
+namespace {
+
+// Unchunked data is stored whole: a damaged header can declare fewer stored bytes than the
+// shape's `count` values need, and libhdf5 then copies from a missing buffer (a crash, found by
+// the artifact fuzzer) instead of failing. Chunked data may be compressed, so its size says
+// nothing.
+void CheckStoredWhole(hid_t ds, int64_t count, const std::string& path, const std::string& name) {
+  Handle plist(H5Dget_create_plist(ds), H5Pclose);
+  Handle type(H5Dget_type(ds), H5Tclose);
+  JVL_CHECK(plist.ok() && type.ok(),
+            path << ": cannot read the layout of dataset '" << name << "' (damaged file?)");
+  const H5D_layout_t layout = H5Pget_layout(plist.get());
+  JVL_CHECK(layout == H5D_CONTIGUOUS || layout == H5D_CHUNKED || layout == H5D_COMPACT,
+            path << ": dataset '" << name << "' has an unknown storage layout (damaged file?)");
+  if (layout == H5D_CHUNKED) return;
+  const uint64_t stored = H5Dget_storage_size(ds);
+  const uint64_t needed = static_cast<uint64_t>(count) * H5Tget_size(type.get());
+  JVL_CHECK(stored == needed, path << ": dataset '" << name << "' stores " << stored
+                                   << " bytes for " << count << " values of "
+                                   << H5Tget_size(type.get()) << " bytes (damaged file?)");
+}
+
+}  // namespace
+
 template <typename T>
 std::vector<T> H5Reader::ReadArray(const std::string& name, int64_t expected_cols) const {
   const auto dims = Dims(name);
@@ -452,24 +476,7 @@ std::vector<T> H5Reader::ReadArray(const std::string& name, int64_t expected_col
   if (count == 0) return out;
   Handle ds(H5Dopen2(impl_->file, name.c_str(), H5P_DEFAULT), H5Dclose);
   JVL_CHECK(ds.ok(), impl_->path << ": cannot open dataset '" << name << "' (damaged file?)");
-  // Unchunked data is stored whole: a damaged header can declare fewer stored bytes than the
-  // shape needs, and libhdf5 then copies from a missing buffer (a crash, found by the artifact
-  // fuzzer) instead of failing. Chunked data may be compressed, so its size says nothing.
-  Handle plist(H5Dget_create_plist(ds.get()), H5Pclose);
-  Handle type(H5Dget_type(ds.get()), H5Tclose);
-  JVL_CHECK(plist.ok() && type.ok(),
-            impl_->path << ": cannot read the layout of dataset '" << name << "' (damaged file?)");
-  const H5D_layout_t layout = H5Pget_layout(plist.get());
-  JVL_CHECK(
-      layout == H5D_CONTIGUOUS || layout == H5D_CHUNKED || layout == H5D_COMPACT,
-      impl_->path << ": dataset '" << name << "' has an unknown storage layout (damaged file?)");
-  if (layout != H5D_CHUNKED) {
-    const uint64_t stored = H5Dget_storage_size(ds.get());
-    const uint64_t needed = static_cast<uint64_t>(count) * H5Tget_size(type.get());
-    JVL_CHECK(stored == needed, impl_->path << ": dataset '" << name << "' stores " << stored
-                                            << " bytes for " << count << " values of "
-                                            << H5Tget_size(type.get()) << " bytes (damaged file?)");
-  }
+  CheckStoredWhole(ds.get(), count, impl_->path, name);
   JVL_CHECK(H5Dread(ds.get(), NativeType<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) >= 0,
             impl_->path << ": cannot read dataset '" << name << "' (damaged file?)");
   return out;
@@ -499,22 +506,7 @@ std::vector<T> H5Reader::ReadRows(const std::string& name,
   if (out.empty()) return out;
   Handle ds(H5Dopen2(impl_->file, name.c_str(), H5P_DEFAULT), H5Dclose);
   JVL_CHECK(ds.ok(), impl_->path << ": cannot open dataset '" << name << "' (damaged file?)");
-  // As in ReadArray: unchunked data must store every value of its declared shape.
-  Handle plist(H5Dget_create_plist(ds.get()), H5Pclose);
-  Handle type(H5Dget_type(ds.get()), H5Tclose);
-  JVL_CHECK(plist.ok() && type.ok(),
-            impl_->path << ": cannot read the layout of dataset '" << name << "' (damaged file?)");
-  const H5D_layout_t layout = H5Pget_layout(plist.get());
-  JVL_CHECK(
-      layout == H5D_CONTIGUOUS || layout == H5D_CHUNKED || layout == H5D_COMPACT,
-      impl_->path << ": dataset '" << name << "' has an unknown storage layout (damaged file?)");
-  if (layout != H5D_CHUNKED) {
-    const uint64_t stored = H5Dget_storage_size(ds.get());
-    const uint64_t needed = static_cast<uint64_t>(dims[0] * cols) * H5Tget_size(type.get());
-    JVL_CHECK(stored == needed, impl_->path << ": dataset '" << name << "' stores " << stored
-                                            << " bytes for " << dims[0] * cols << " values of "
-                                            << H5Tget_size(type.get()) << " bytes (damaged file?)");
-  }
+  CheckStoredWhole(ds.get(), dims[0] * cols, impl_->path, name);
   Handle file_space(H5Dget_space(ds.get()), H5Sclose);
   JVL_CHECK(file_space.ok(), impl_->path << ": cannot read the shape of '" << name << "'");
   size_t offset = 0;
