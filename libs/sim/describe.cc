@@ -167,9 +167,8 @@ nlohmann::json DescribeScene(const World& world) {
                 {"range_noise", l.range_noise},
                 {"dropout", l.dropout},
                 {"motion_distortion", l.motion_distortion},
+                {"elevation_bias_deg", l.elevation_bias_deg},
                 {"height_m", world.options.lidar_height}};
-  // Written only when set, so that scene.json of the default sensors stays as it was.
-  if (l.elevation_bias_deg != 0) j["lidar"]["elevation_bias_deg"] = l.elevation_bias_deg;
   if (world.options.calib_error_deg != 0 || world.options.calib_error_m != 0) {
     const Rigid3d error = WrittenCalibrationError(world.options);
     j["calibration_error"] = {

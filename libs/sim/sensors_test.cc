@@ -25,13 +25,17 @@ std::unique_ptr<World> SmallWorld(double range_noise, double dropout) {
   return BuildWorld(opt);
 }
 
-// Every return lies on a scene surface: re-casting the ray towards the point finds a surface
-// at the measured range, within the range noise.
+// Every return lies on a scene surface: re-casting the ray towards the point, once its elevation
+// bias (the default one) is corrected, finds a surface at the measured range, within the range
+// noise.
 TEST(LidarTest, ReturnsLieOnSurfacesWithinNoise) {
   for (double sigma : {0.0, 0.02}) {
     const auto world = SmallWorld(sigma, 0.0);
-    const SimFrame f = SimulateFrame(*world, 12);
+    SimFrame f = SimulateFrame(*world, 12);
     ASSERT_GT(f.scan.size(), 60000u);
+    ASSERT_GT(world->options.lidar.elevation_bias_deg, 0.0);
+    lidar::CorrectVerticalAngle(world->options.lidar.elevation_bias_deg * M_PI / 180,
+                                &f.scan.points);
     const Rigid3d map_from_velo = world->MapFromVeloAt(f.time);
     std::vector<Box> moving;
     for (size_t i = 0; i < world->scene.moving_cars.size(); ++i) {
@@ -318,6 +322,7 @@ TEST(LidarTest, MotionDistortionShiftsColumnsByTheMotion) {
   LidarOptions opt;
   opt.range_noise = 0;
   opt.dropout = 0;
+  opt.elevation_bias_deg = 0;
   const SweepPose sweep = [](double tau) {
     return Rigid3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(10 * tau, 0, 0));
   };
@@ -345,6 +350,7 @@ TEST(LidarTest, ElevationBiasLowersEveryReturnAndTheCorrectionUndoesIt) {
   const RayCaster caster(scene.mesh);
   LidarOptions opt;
   opt.dropout = 0;
+  opt.elevation_bias_deg = 0;
   const PointCloud plain = SimulateScan(scene, caster, Rigid3d(), {}, opt, 3);
   opt.elevation_bias_deg = 0.22;
   const PointCloud biased = SimulateScan(scene, caster, Rigid3d(), {}, opt, 3);

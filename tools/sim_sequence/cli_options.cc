@@ -29,7 +29,8 @@ void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
                "Move the LiDAR during the 0.1 s sweep");
   sensors.Add("--lidar-elevation-bias", "elevation_bias_deg", o->lidar.elevation_bias_deg,
               "Report every LiDAR return this much (deg) below its beam, as the KITTI HDL-64E "
-              "scans do by about 0.2 (lidar_odom --vertical-correction undoes it); 0: none");
+              "scans do (the default gives calib_check KITTI 04's pitch reading; lidar_odom "
+              "--vertical-correction undoes it); 0: none");
   sensors.Add("--calib-error-deg", "calib_error_deg", o->calib_error_deg,
               "Write calib.txt's camera-LiDAR extrinsic (Tr) rotated this much (deg) off the "
               "rig the data come from, about an axis drawn from the seed; 0: the true rig");
