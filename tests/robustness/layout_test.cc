@@ -39,6 +39,7 @@
 
 #include "io/files.h"
 #include "io/trajectory_io.h"
+#include "lidar/registration.h"
 
 namespace jvl::testing {
 namespace {
@@ -46,7 +47,8 @@ namespace {
 const std::string kDir = std::string(JVL_BINARY_DIR) + "/tests/robustness/";
 constexpr double kTolerance = 1e-9;
 constexpr double kRotationApeToleranceDeg = 1e-6;
-constexpr double kOdometryTolerance = 5e-4;  // lidar::RegistrationOptions' step threshold (m).
+// lidar_odom's registration step threshold (m).
+const double kOdometryTolerance = lidar::RegistrationOptions().convergence_translation;
 
 class LayoutTest : public ::testing::Test {
  protected:
