@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -22,16 +24,17 @@ struct Correspondence {
 };
 
 // Correspondences as local mapping produces them: p_x up to ~60 m from keyframe n, c_p_y near
-// its image in c (a few cm off the surface), unit normals.
+// its image in c (up to `off_surface` m off the surface), unit normals.
 std::vector<Correspondence> RandomPair(std::mt19937& rng, const Rigid3d& world_from_n,
-                                       const Rigid3d& world_from_c, int count) {
+                                       const Rigid3d& world_from_c, int count,
+                                       double off_surface = 0.05) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<Correspondence> out;
   for (int i = 0; i < count; ++i) {
     Correspondence l;
     l.p_x = Eigen::Vector3d(60 * u(rng), 3 * u(rng), 40 + 20 * u(rng));
     l.c_normal = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
-    l.c_p_y = world_from_c.Inverse() * (world_from_n * l.p_x) + 0.05 * u(rng) * l.c_normal +
+    l.c_p_y = world_from_c.Inverse() * (world_from_n * l.p_x) + off_surface * u(rng) * l.c_normal +
               Eigen::Vector3d(u(rng), u(rng), u(rng)).cross(l.c_normal) * 0.3;
     out.push_back(l);
   }
@@ -121,7 +124,8 @@ TEST(ImlsPairCost, FewCorrespondencesGiveOneRowEach) {
   for (const auto& l : pair) acc.Add(l.p_x, l.c_p_y, l.c_normal);
   const ImlsPairCost block(acc, 20.0);
   EXPECT_EQ(block.rank(), 4);
-  PoseBlock pn = ToPoseBlock(world_from_n * RandomPose(rng, 0.02, 0.3)), pc = ToPoseBlock(world_from_c);
+  PoseBlock pn = ToPoseBlock(world_from_n * RandomPose(rng, 0.02, 0.3)),
+            pc = ToPoseBlock(world_from_c);
   double* params[2] = {pn.data(), pc.data()};
   Normal individual, compressed;
   for (const auto& l : pair)
@@ -167,6 +171,56 @@ TEST(ImlsPairCost, JointProblemWithPairBlocksReachesTheSameSolution) {
   huber.imls_huber = 2.0;
   EXPECT_EQ(BuildJointProblem(toy.input, huber).imls_blocks.size(), toy.input.imls.size());
   EXPECT_THROW(BuildJointProblem(split, huber), Error);
+}
+
+// imls_pair_noise_max: a pair whose residuals are f times the median pair's gets the sigma x
+// min(f, max), i.e. its block cost / min(f, max)^2; the other pairs keep theirs. Off (<= 1),
+// every block is as before.
+TEST(ImlsPairCost, PairNoiseRaisesTheSigmaOfRoughPairsOnly) {
+  std::mt19937 rng(5);
+  JointProblemInput input;
+  input.camera = testing::MakeToyRoad(false).input.camera;
+  Rigid3d pose = RandomPose(rng, 0.1, 1.0);
+  for (int64_t k = 0; k < 6; ++k) {
+    input.poses[k] = pose;
+    pose = pose * RandomPose(rng, 0.02, 1.0);
+  }
+  // Pairs (k, k - 1): four with points up to 2 cm off the surface, one rough (12 cm: 6x).
+  for (int64_t k = 1; k < 6; ++k) {
+    const double off = k == 3 ? 0.12 : 0.02;
+    for (const auto& l : RandomPair(rng, input.poses[k], input.poses[k - 1], 400, off))
+      input.imls.push_back({k, k - 1, l.p_x, l.c_p_y, l.c_normal});
+  }
+  JointProblemOptions off, on;
+  on.imls_pair_noise_max = 3.0;
+  off.beta = on.beta = 1.0;
+  JointProblem a = BuildJointProblem(input, off);
+  JointProblem b = BuildJointProblem(input, on);
+  ASSERT_EQ(a.imls_blocks.size(), 5u);
+  ASSERT_EQ(b.imls_blocks.size(), 5u);
+  // Each pair's RMS from its block cost without the option: cost = 0.5 sum r^2 / sigma^2.
+  std::vector<double> cost_a(5), cost_b(5), rms(5);
+  for (size_t i = 0; i < 5; ++i) {
+    ASSERT_TRUE(
+        a.problem->EvaluateResidualBlock(a.imls_blocks[i], false, &cost_a[i], nullptr, nullptr));
+    ASSERT_TRUE(
+        b.problem->EvaluateResidualBlock(b.imls_blocks[i], false, &cost_b[i], nullptr, nullptr));
+    rms[i] = std::sqrt(2.0 * cost_a[i] / 400.0) * off.imls_sigma_m;
+  }
+  std::vector<double> sorted = rms;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted[2];
+  // Uniform noise on [-s, s] has RMS s / sqrt(3): about 11.5 mm for the clean pairs.
+  EXPECT_NEAR(b.imls_pair_median_rms_m, median, 1e-8 * median);  // LDL^T vs x^T H x rounding
+  EXPECT_NEAR(median, 0.02 / std::sqrt(3.0), 0.002);
+  EXPECT_GT(rms[2] / median, 4.0);  // pair (3, 2): its sigma is capped at 3x
+  EXPECT_EQ(a.imls_pairs_inflated, 0);
+  EXPECT_EQ(b.imls_pairs_inflated, 2);  // the rough pair and the clean one above the median
+  for (size_t i = 0; i < 5; ++i) {
+    const double f = std::clamp(rms[i] / median, 1.0, 3.0);
+    EXPECT_NEAR(cost_b[i], cost_a[i] / (f * f), 1e-7 * cost_a[i]) << "pair " << i;
+  }
+  EXPECT_NEAR(cost_b[2], cost_a[2] / 9.0, 1e-7 * cost_a[2]);
 }
 
 }  // namespace

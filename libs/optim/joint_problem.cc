@@ -232,13 +232,42 @@ void AddVisual(const JointProblemInput& input, const JointProblemOptions& option
   }
 }
 
+// RMS of one pair's residuals at the problem's initial poses: sum r_i^2 = x^T H x.
+double PairRms(const ImlsPairAccumulator& sum, const PoseBlock& pose_n, const PoseBlock& pose_c) {
+  const Eigen::Matrix<double, 13, 1> x =
+      ImlsPairCost::RelativePoseVector(pose_n.data(), pose_c.data());
+  const Eigen::Matrix<double, 13, 13> h = sum.information().selfadjointView<Eigen::Lower>();
+  return std::sqrt(std::max(0.0, x.dot(h * x)) / static_cast<double>(sum.count()));
+}
+
 void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
              ceres::LossFunction* loss, JointProblem& jp) {
   const double sqrt_info = 1.0 / options.imls_sigma_m;
   if (options.SumsImlsPerPair()) {
     // One exact block per keyframe pair (imls_pair_cost.h).
-    for (const auto& [key, sum] : SumByPair(input.imls_pairs, input.imls)) {
-      auto cost = std::make_unique<ImlsPairCost>(sum, sqrt_info);
+    const auto pairs = SumByPair(input.imls_pairs, input.imls);
+    // imls_pair_noise_max: each pair's sigma from its RMS residual against the median pair's.
+    std::vector<double> factor(pairs.size(), 1.0);
+    if (options.imls_pair_noise_max > 1.0 && !pairs.empty()) {
+      std::vector<double> rms;
+      rms.reserve(pairs.size());
+      for (const auto& [key, sum] : pairs)
+        rms.push_back(
+            sum.count() > 0 ? PairRms(sum, jp.poses.at(key.first), jp.poses.at(key.second)) : 0.0);
+      std::vector<double> sorted = rms;
+      const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+      std::nth_element(sorted.begin(), mid, sorted.end());
+      jp.imls_pair_median_rms_m = *mid;
+      if (*mid > 0) {
+        for (size_t i = 0; i < rms.size(); ++i) {
+          factor[i] = std::clamp(rms[i] / *mid, 1.0, options.imls_pair_noise_max);
+          if (factor[i] > 1.0) ++jp.imls_pairs_inflated;
+        }
+      }
+    }
+    size_t i = 0;
+    for (const auto& [key, sum] : pairs) {
+      auto cost = std::make_unique<ImlsPairCost>(sum, sqrt_info / factor[i++]);
       if (cost->rank() == 0) continue;  // only for an all-zero sum; nothing to add
       jp.imls_blocks.push_back(jp.problem->AddResidualBlock(
           cost.release(), loss, jp.poses.at(key.first).data(), jp.poses.at(key.second).data()));
@@ -303,6 +332,7 @@ void JointProblemOptions::Check() const {
   JVL_CHECK(std::isfinite(direction_sigma_v_px) && direction_sigma_v_px >= 0,
             "direction_sigma_v_px must be >= 0 (0: as direction_sigma_px)");
   JVL_CHECK(direction_min_z > 0 && direction_min_z < 1, "direction_min_z must be in (0, 1)");
+  JVL_CHECK(std::isfinite(imls_pair_noise_max), "imls_pair_noise_max must be finite");
   JVL_CHECK(std::isfinite(relative_cauchy), "relative_cauchy must be finite");
   JVL_CHECK(std::isfinite(motion_cauchy), "motion_cauchy must be finite");
   JVL_CHECK(std::isfinite(surface_sigma_m) && surface_sigma_m > 0,

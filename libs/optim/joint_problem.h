@@ -144,7 +144,13 @@ struct JointProblemOptions {
   // Noise models (square-root information = 1 / sigma).
   double octave_scale_factor = 1.2;  // ORB-SLAM: sigma_V = 1.2^octave px
   double imls_sigma_m = 0.05;        // e_L in metres
-  double direction_sigma_px = 1.0;   // e_D in pixels (image u; v too unless set below)
+  // > 1: e_L's noise per keyframe pair from the pair's own fit (summed form only, i.e.
+  // SumsImlsPerPair): a pair whose RMS point-to-surface residual at the initial poses is f times
+  // the median pair's (f > 1) gets the sigma imls_sigma_m x min(f, imls_pair_noise_max). One
+  // sigma for all pairs overstates what a rough surface (vegetation, clutter) tells: its
+  // residuals are larger at any pose. <= 1: one sigma for every pair.
+  double imls_pair_noise_max = 0.0;
+  double direction_sigma_px = 1.0;  // e_D in pixels (image u; v too unless set below)
   // e_D's v (image row) component, when it has a noise of its own (> 0): on sloped roads the
   // VP's row also holds the grade of the road ahead, which varies along one direction prior.
   double direction_sigma_v_px = 0.0;
@@ -220,6 +226,10 @@ struct JointProblem {
   // free map points left with fewer than 2 (counted in gated_observations too).
   int64_t gated_observations = 0, gated_points = 0;
   int64_t weak_points = 0;  // held constant or dropped by max_point_sigma_ratio
+  // imls_pair_noise_max: the median pair RMS residual at the initial poses (m) and the pairs
+  // given a larger sigma.
+  double imls_pair_median_rms_m = 0.0;
+  int64_t imls_pairs_inflated = 0;
   bool has_free_map_points = false;
 };
 
@@ -272,6 +282,8 @@ struct JointSolveResult {
   JointWeights weights;
   int iterations = 0;
   int64_t imls_blocks = 0;  // residual blocks holding the e_L terms (one per pair when summed)
+  double imls_pair_median_rms_m = 0.0;  // JointProblem's, see there
+  int64_t imls_pairs_inflated = 0;
   // Visual observations left out when the problem was built (JointProblem's counts).
   int64_t dropped_observations = 0, gated_observations = 0, gated_points = 0, weak_points = 0;
   double time_s = 0.0;

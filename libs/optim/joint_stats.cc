@@ -151,6 +151,8 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   result.gated_observations = jp.gated_observations;
   result.gated_points = jp.gated_points;
   result.weak_points = jp.weak_points;
+  result.imls_pair_median_rms_m = jp.imls_pair_median_rms_m;
+  result.imls_pairs_inflated = jp.imls_pairs_inflated;
   Timer phase;
   result.before = options.evaluate_before ? EvaluateJointCost(jp) : CountResiduals(jp);
   const double before_s = phase.ElapsedSeconds();

@@ -65,6 +65,10 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
               "Put the visual loops' points (PnP inliers) into the visual term, observed by both "
               "ends; weak ones left out (--no-loop-points: the loops' correction and IMLS term "
               "only)");
+  method.Add("--imls-pair-noise-max", o->joint.imls_pair_noise_max,
+             "e_L's noise per keyframe pair: a pair whose RMS point-to-surface residual at the "
+             "round's starting poses is f times the median pair's gets the sigma times min(f, "
+             "this), so rough surfaces (vegetation) weigh less (<= 1: one sigma for all pairs)");
   method.Flag("!--no-odometry", o->use_odometry,
               "Leave out the odometry term e_O (the paper's energy; ablation)");
   method.Add("--odometry-gate", o->odometry_gate,
