@@ -110,7 +110,13 @@ double Ape(const nlohmann::json& metrics, size_t i, const char* field) {
   return metrics.at("estimates").at(i).at("ape").at(field).at("rmse").get<double>();
 }
 
-// Every estimate of `run` matches as many frames as run_a's, at 0.7-1.4x its translation APE.
+// Every estimate of `run` matches as many frames as run_a's, at 0.25-1.4x its translation APE.
+// Another layout is other data (another camera's images, another sensor frame), and its result
+// may be better: the global results here are a few mm (run_a 4.4 mm, Oxford and camera 2
+// 2.9 mm since e_L's noise is measured per keyframe pair). The upper bound is the check that
+// a layout does not make the chain worse; the lower one only catches a degenerate evaluation
+// (an estimate compared with itself gives about 0). The trajectories themselves are compared
+// with ExpectWithinTheChainsError.
 void ExpectApeWithinTheChainsNoise(const std::string& run) {
   const nlohmann::json a = LoadMetrics("run_a"), b = LoadMetrics(run);
   ASSERT_EQ(a.at("estimates").size(), 4u);
@@ -118,7 +124,7 @@ void ExpectApeWithinTheChainsNoise(const std::string& run) {
   for (size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(a["estimates"][i].at("frames_matched"), b["estimates"][i].at("frames_matched"));
     const double ratio = Ape(b, i, "translation_m") / Ape(a, i, "translation_m");
-    EXPECT_GT(ratio, 0.7) << run << " " << a["estimates"][i].at("label");
+    EXPECT_GT(ratio, 0.25) << run << " " << a["estimates"][i].at("label");
     EXPECT_LT(ratio, 1.4) << run << " " << a["estimates"][i].at("label");
   }
 }
