@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "core/check.h"
+#include "core/statistics.h"
 #include "optim/analytic_costs.h"
 #include "optim/cost_functions.h"
 #include "optim/imls_pair_cost.h"
@@ -254,13 +255,11 @@ void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
       for (const auto& [key, sum] : pairs)
         rms.push_back(
             sum.count() > 0 ? PairRms(sum, jp.poses.at(key.first), jp.poses.at(key.second)) : 0.0);
-      std::vector<double> sorted = rms;
-      const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
-      std::nth_element(sorted.begin(), mid, sorted.end());
-      jp.imls_pair_median_rms_m = *mid;
-      if (*mid > 0) {
+      const double median = UpperMedian(rms);
+      jp.imls_pair_median_rms_m = median;
+      if (median > 0) {
         for (size_t i = 0; i < rms.size(); ++i) {
-          factor[i] = std::clamp(rms[i] / *mid, 1.0, options.imls_pair_noise_max);
+          factor[i] = std::clamp(rms[i] / median, 1.0, options.imls_pair_noise_max);
           if (factor[i] > 1.0) ++jp.imls_pairs_inflated;
         }
       }
