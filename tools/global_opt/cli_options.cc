@@ -80,6 +80,11 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
   method.Add("--odometry-max-inflation", o->odometry_max_inflation,
              "Largest factor on a weakly conditioned (or unregistered) frame's e_O sigma, "
              "sqrt(median / own smallest eigenvalue of the registration), >= 1");
+  method.Add("--odometry-local-window", o->odometry_local_window,
+             "e_O's local noise: pairs on either side whose median whitened residual (first "
+             "round, relative to the drive's median) multiplies a pair's sigma (0: off)");
+  method.Add("--odometry-local-max", o->odometry_local_max,
+             "Largest factor of e_O's local noise on a pair's sigma, >= 1");
   method.Add("--odometry-cauchy", o->joint.relative_cauchy,
              "Cauchy kernel scale of e_O on its whitened norm (<= 0: none)");
   method.Flag("!--no-surface", o->use_surface,

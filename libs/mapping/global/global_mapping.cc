@@ -163,6 +163,10 @@ void GlobalMappingOptions::Check() const {
   JVL_CHECK(std::isfinite(odometry_gate), "odometry_gate must be finite");
   JVL_CHECK(std::isfinite(odometry_max_inflation) && odometry_max_inflation >= 1,
             "odometry_max_inflation must be >= 1, got " << odometry_max_inflation);
+  JVL_CHECK(odometry_local_window >= 0,
+            "odometry_local_window must be >= 0 (0 = off), got " << odometry_local_window);
+  JVL_CHECK(std::isfinite(odometry_local_max) && odometry_local_max >= 1,
+            "odometry_local_max must be >= 1, got " << odometry_local_max);
   JVL_CHECK(std::isfinite(surface_max_distance_m) && surface_max_distance_m > 0 &&
                 surface_max_distance_m <= traversal.association.search_radius,
             "surface_max_distance_m must be in (0, " << traversal.association.search_radius
@@ -434,6 +438,27 @@ std::vector<double> OdometryVarianceFactors(const std::vector<double>& condition
   return factor;
 }
 
+// Per odometry pair, the factor of its local noise (GlobalMappingOptions::odometry_local_window):
+// the median of the whitened residual norms within the window, divided by the drive's median,
+// clamped to [1, odometry_local_max]; all 1 when off.
+std::vector<double> OdometryLocalFactors(const std::vector<double>& norm,
+                                         const GlobalMappingOptions& options,
+                                         GlobalMappingResult* result) {
+  std::vector<double> factor(norm.size(), 1.0);
+  if (options.odometry_local_window <= 0 || norm.empty()) return factor;
+  const double reference = Median(norm);
+  result->odometry_median_norm = reference;
+  if (!(reference > 0)) return factor;
+  const auto w = static_cast<size_t>(options.odometry_local_window);
+  for (size_t k = 0; k < norm.size(); ++k) {
+    const size_t begin = k >= w ? k - w : 0;
+    const size_t end = std::min(norm.size(), k + w + 1);
+    const double local = Median(std::vector<double>(norm.begin() + begin, norm.begin() + end));
+    factor[k] = std::clamp(local / reference, 1.0, options.odometry_local_max);
+  }
+  return factor;
+}
+
 // The odometry's motion between consecutive keyframes whose frames it holds, with a sigma per
 // axis measured against `keyframes` (the first round's solution): 1.4826 x the median absolute
 // per-frame residual (MAD about zero; each residual divided by its pair's scale), at least the
@@ -489,24 +514,35 @@ void EnterOdometry(const Trajectory& keyframes, const Trajectory& odometry,
   }
   result->odometry_sigma_deg = sigma_rad * kDegPerRad;
   result->odometry_sigma_m = sigma_m;
+  std::vector<double> norm(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    pairs[k].sigma_rad = sigma_rad * scale[k];
+    pairs[k].sigma_m = sigma_m * scale[k];
+    norm[k] = std::sqrt(WhitenedSquaredNorm(pairs[k], keyframes));
+  }
+  const std::vector<double> local = OdometryLocalFactors(norm, options, result);
   for (size_t k = 0; k < pairs.size(); ++k) {
     optim::RelativePoseConstraint c = pairs[k];
-    c.sigma_rad = sigma_rad * scale[k];
-    c.sigma_m = sigma_m * scale[k];
     if (inflation[k] > 2.0) ++result->odometry_inflated;
-    if (options.odometry_gate > 0 &&
-        WhitenedSquaredNorm(c, keyframes) > options.odometry_gate * options.odometry_gate) {
+    if (options.odometry_gate > 0 && norm[k] > options.odometry_gate) {
       ++result->odometry_gated;
       continue;
+    }
+    if (local[k] > 1.0) {
+      c.sigma_rad *= local[k];
+      c.sigma_m *= local[k];
+      ++result->odometry_local_inflated;
     }
     term->constraints.push_back(c);
   }
   spdlog::info(
       "odometry term: {} keyframe pairs ({} left out above the gate, {} with a sigma raised "
-      "over 2x by a weakly conditioned registration), sigma per frame ({:.4f}, {:.4f}, {:.4f}) m, "
-      "({:.4f}, {:.4f}, {:.4f}) deg (camera x, y, z; measured against the first round)",
-      term->constraints.size(), result->odometry_gated, result->odometry_inflated, sigma_m.x(),
-      sigma_m.y(), sigma_m.z(), result->odometry_sigma_deg.x(), result->odometry_sigma_deg.y(),
+      "over 2x by a weakly conditioned registration, {} raised by the local noise), sigma per "
+      "frame ({:.4f}, {:.4f}, {:.4f}) m, ({:.4f}, {:.4f}, {:.4f}) deg (camera x, y, z; measured "
+      "against the first round)",
+      term->constraints.size(), result->odometry_gated, result->odometry_inflated,
+      result->odometry_local_inflated, sigma_m.x(), sigma_m.y(), sigma_m.z(),
+      result->odometry_sigma_deg.x(), result->odometry_sigma_deg.y(),
       result->odometry_sigma_deg.z());
 }
 
@@ -1149,6 +1185,11 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
          {{"used", r.odometry_conditioned},
           {"max_inflation", o.odometry_max_inflation},
           {"inflated", r.odometry_inflated}}},
+        {"local",
+         {{"window", o.odometry_local_window},
+          {"max", o.odometry_local_max},
+          {"median_norm", r.odometry_median_norm},
+          {"inflated", r.odometry_local_inflated}}},
         {"cauchy", o.joint.relative_cauchy}}},
       {"surface",
        {{"enabled", o.use_surface},

@@ -193,6 +193,16 @@ struct GlobalMappingOptions {
   // drive (above) is measured on residuals divided by the same factor.
   bool odometry_conditioning = true;
   double odometry_max_inflation = 10.0;
+  // Local noise of e_O (beyond the paper): the odometry's errors come in stretches (a street
+  // where the registration slides, the biased scans of an open road), not frame by frame. Each
+  // pair's sigma (after the conditioning) is also multiplied by the median whitened residual norm
+  // of the pairs within odometry_local_window pairs on either side, itself included and gated
+  // pairs included, at the first round's solution, divided by that median over the whole drive;
+  // clamped to [1, odometry_local_max]. An isolated step leaves its neighbours' median as it is
+  // (the gate takes the step out); a stretch where the odometry disagrees with the other terms
+  // pair after pair weighs less there. 0: off.
+  int odometry_local_window = 5;
+  double odometry_local_max = 3.0;
   // Motion term e_M (beyond the paper, docs/global_opt.md "Motion term"): in every round, each
   // three consecutive keyframes' change of body-frame velocity per frame
   // (optim::MotionSmoothnessCost), whitened by the vehicle's acceleration noise per axis of the
@@ -263,6 +273,10 @@ struct GlobalMappingResult {
   int64_t odometry_pairs = 0, odometry_gated = 0, odometry_outliers = 0;
   // Pairs whose sigma the conditioning raised by more than 2x (odometry_conditioning).
   int64_t odometry_inflated = 0;
+  // Pairs kept in e_O whose sigma the local noise raised (odometry_local_window), and the
+  // drive's median whitened residual norm the local medians are divided by.
+  int64_t odometry_local_inflated = 0;
+  double odometry_median_norm = 0;
   int64_t surface_constraints = 0;    // e_S of the last round
   bool odometry_conditioned = false;  // The conditioning of the odometry's frames was used.
   Eigen::Vector3d odometry_sigma_m = Eigen::Vector3d::Zero();  // per frame, camera x, y, z
