@@ -119,16 +119,40 @@ struct AblationFigures {
   GlobalMappingResult result_with;
 };
 
-// Runs the global optimisation with the options `with` and with the same options but no direction
-// priors on a synthetic sequence; the saved set L of local mapping is emulated by an N = 1
-// traversal at the prior poses.
-AblationFigures RunAblation(const SyntheticGlobalOptions& so,
-                            const GlobalMappingOptions& with = Quiet()) {
-  auto syn = MakeSyntheticGlobal(so);
+// The saved set L of local mapping, emulated by an N = 1 traversal at the prior poses.
+void EmulateSavedImls(testing::SyntheticGlobal* syn) {
   ImlsTraversalOptions local;
   local.scan_map_size = 1;
   local.association.samples_per_list = 10;
-  syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
+  syn->input.saved_imls = TraverseImls(syn->input.keyframes, syn->input.scans, local, 2);
+}
+
+// An odometry of `truth`: each frame's motion with 1 mm of noise across the road (x, y; seeded),
+// then `perturb(frame, &translation)`.
+template <typename Perturb>
+Trajectory NoisyOdometry(const Trajectory& truth, uint32_t seed, Perturb perturb) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  Trajectory odometry;
+  Rigid3d pose = truth.world_from_cam[0];
+  for (size_t f = 0; f < truth.size(); ++f) {
+    if (f > 0) {
+      const Rigid3d motion = truth.world_from_cam[f - 1].Inverse() * truth.world_from_cam[f];
+      Eigen::Vector3d t = motion.translation() + Eigen::Vector3d(noise(rng), noise(rng), 0.0);
+      perturb(truth.frames[f], &t);
+      pose = pose * Rigid3d(motion.rotation(), t);
+    }
+    odometry.Append(truth.frames[f], pose);
+  }
+  return odometry;
+}
+
+// Runs the global optimisation with the options `with` and with the same options but no direction
+// priors on a synthetic sequence, with the saved set L emulated (EmulateSavedImls).
+AblationFigures RunAblation(const SyntheticGlobalOptions& so,
+                            const GlobalMappingOptions& with = Quiet()) {
+  auto syn = MakeSyntheticGlobal(so);
+  EmulateSavedImls(&syn);
   GlobalMappingOptions without = with;
   without.use_directions = false;
   AblationFigures f;
@@ -255,25 +279,12 @@ TEST(GlobalMapping, OdometryTermSmoothsAndLeavesTheOdometrysStepOut) {
   so.biased_local = false;
   so.yaw_drift = 0.1 * M_PI / 180.0;
   auto syn = MakeSyntheticGlobal(so);
-  ImlsTraversalOptions local;
-  local.scan_map_size = 1;
-  local.association.samples_per_list = 10;
-  syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
+  EmulateSavedImls(&syn);
   const int step_keyframe = 15;  // the jump lies between keyframes 15 and 16
   const int64_t step_frame = syn.input.keyframes.frames[step_keyframe + 1];
-  std::mt19937 rng(11);
-  std::normal_distribution<double> noise(0.0, 0.001);
-  Trajectory odometry;
-  Rigid3d pose = syn.truth.world_from_cam[0];
-  for (size_t f = 0; f < syn.truth.size(); ++f) {
-    if (f > 0) {
-      Rigid3d motion = syn.truth.world_from_cam[f - 1].Inverse() * syn.truth.world_from_cam[f];
-      Eigen::Vector3d t = motion.translation() + Eigen::Vector3d(noise(rng), noise(rng), 0.0);
-      if (syn.truth.frames[f] == step_frame) t.x() += 0.3;
-      pose = pose * Rigid3d(motion.rotation(), t);
-    }
-    odometry.Append(syn.truth.frames[f], pose);
-  }
+  const Trajectory odometry = NoisyOdometry(syn.truth, 11, [&](int64_t frame, Eigen::Vector3d* t) {
+    if (frame == step_frame) t->x() += 0.3;
+  });
   syn.input.odometry = odometry;
   GlobalMappingOptions o = Quiet();
   o.use_directions = false;
@@ -333,27 +344,12 @@ TEST(GlobalMapping, OdometryLocalNoiseWeighsASlidingStretchLess) {
   so.keyframes = 40;
   so.biased_local = false;
   auto syn = MakeSyntheticGlobal(so);
-  ImlsTraversalOptions local;
-  local.scan_map_size = 1;
-  local.association.samples_per_list = 10;
-  syn.input.saved_imls = TraverseImls(syn.input.keyframes, syn.input.scans, local, 2);
+  EmulateSavedImls(&syn);
   // Keyframes 20..30: every frame 1.5 cm off along the road, alternating in sign.
   const int64_t first = syn.input.keyframes.frames[20], last = syn.input.keyframes.frames[30];
-  std::mt19937 rng(5);
-  std::normal_distribution<double> noise(0.0, 0.001);
-  Trajectory odometry;
-  Rigid3d pose = syn.truth.world_from_cam[0];
-  for (size_t f = 0; f < syn.truth.size(); ++f) {
-    if (f > 0) {
-      Rigid3d motion = syn.truth.world_from_cam[f - 1].Inverse() * syn.truth.world_from_cam[f];
-      Eigen::Vector3d t = motion.translation() + Eigen::Vector3d(noise(rng), noise(rng), 0.0);
-      const int64_t frame = syn.truth.frames[f];
-      if (frame > first && frame <= last) t.z() += frame % 2 == 0 ? 0.015 : -0.015;
-      pose = pose * Rigid3d(motion.rotation(), t);
-    }
-    odometry.Append(syn.truth.frames[f], pose);
-  }
-  syn.input.odometry = odometry;
+  syn.input.odometry = NoisyOdometry(syn.truth, 5, [&](int64_t frame, Eigen::Vector3d* t) {
+    if (frame > first && frame <= last) t->z() += frame % 2 == 0 ? 0.015 : -0.015;
+  });
   GlobalMappingOptions o = Quiet();
   o.use_directions = false;
   const GlobalMappingResult on = OptimizeGlobal(syn.input, o);
