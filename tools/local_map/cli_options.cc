@@ -35,6 +35,9 @@ void AddLocalMapFlags(app::Tool& tool, mapping::LocalMappingOptions* o, mapping:
 
   app::OptionGroup scan(tool, "Scans");
   scan.Add("--min-range", s->preprocess.min_range, "Drop points closer than this (m)");
+  scan.Add("--vertical-correction", "vertical_correction_deg",
+           s->preprocess.vertical_correction_deg,
+           "Elevation correction of every return (deg; KITTI HDL-64: 0.205; 0 = off)");
   scan.Add("--voxel-size", s->preprocess.voxel_size, "Voxel downsampling of each scan (m)");
   scan.Add("--scan-voxel", "stored_voxel", s->stored_voxel,
            "Voxel of the scans stored in the artifact (m)");

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "mapping/local/local_artifact.h"
+#include "mapping/local/local_scan.h"
 #include "mapping/local/local_test_scene.h"
 #include "mapping/local/local_test_util.h"
 #include "optim/cost_functions.h"
@@ -39,6 +40,54 @@ TEST(LocalMapping, SweepMotionFromTheNeighbouringFrames) {
   EXPECT_LT((LogSE3(*SweepMotion(t, 0)) - LogSE3(between(0, 1))).norm(), 1e-12);
   EXPECT_LT((LogSE3(*SweepMotion(t, 3)) - LogSE3(between(2, 3))).norm(), 1e-12);
   EXPECT_FALSE(SweepMotion(t, 10).has_value());
+}
+
+// A velodyne scan of flat ground 1.73 m below the sensor whose every return is reported
+// `bias_deg` below the beam it was fired along (same range and azimuth: the HDL-64's elevation
+// error, sim_sequence --lidar-elevation-bias).
+PointCloud BiasedGroundScan(double bias_deg) {
+  PointCloud scan;
+  const double bias = bias_deg * M_PI / 180.0;
+  for (int ring = 0; ring < 24; ++ring) {
+    const double elevation = (-24.0 + ring * 0.9) * M_PI / 180.0;
+    const double range = 1.73 / std::sin(-elevation);
+    for (int a = 0; a < 3600; ++a) {
+      const double azimuth = a * 0.1 * M_PI / 180.0;
+      const double e = elevation - bias;
+      scan.points.emplace_back(range * std::cos(e) * std::cos(azimuth),
+                               range * std::cos(e) * std::sin(azimuth), range * std::sin(e));
+    }
+  }
+  return scan;
+}
+
+// The stored scan's ground (cam0: y down) is flat when local_map's --vertical-correction undoes
+// the bias, and a cone sinking with range without it: its mean slope (drop / horizontal
+// distance) is tan(bias).
+TEST(LocalMapping, KeyframeScanTakesTheElevationCorrection) {
+  // KITTI's axes: cam0 x = -velo y, y = -velo z, z = velo x.
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  const Rigid3d cam0_from_velo(Eigen::Quaterniond(r), Eigen::Vector3d::Zero());
+  const PointCloud scan = BiasedGroundScan(0.2);
+  const auto slope_deg = [&](double correction_deg) {
+    ScanOptions options;
+    options.preprocess.vertical_correction_deg = correction_deg;
+    const KeyframeScan prepared = PrepareKeyframeScan(scan, cam0_from_velo, options, 100, 1);
+    double sum = 0;
+    int count = 0;
+    for (const auto& p : prepared.stored.points) {
+      const double d = std::hypot(p.x(), p.z());
+      if (d < 10) continue;
+      sum += (p.y() - 1.73) / d;
+      ++count;
+    }
+    EXPECT_GT(count, 100);
+    return std::atan(sum / std::max(count, 1)) * 180.0 / M_PI;
+  };
+  EXPECT_NEAR(slope_deg(0.0), 0.2, 0.01);
+  EXPECT_NEAR(slope_deg(0.2), 0.0, 0.01);
+  EXPECT_NEAR(slope_deg(0.4), -0.2, 0.01);  // over-corrected: a cone the other way
 }
 
 TEST(LocalMapping, StartKeyframeIsFirstWithinNFrames) {
