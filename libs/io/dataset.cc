@@ -60,6 +60,19 @@ bool ResolveDeskew(const std::string& mode, const Dataset& dataset) {
   return deskew;
 }
 
+double ResolveVerticalCorrection(const std::string& value, const Dataset& dataset) {
+  if (value != "auto") {
+    const auto deg = ParseDouble(value);
+    JVL_CHECK(deg && std::isfinite(*deg),
+              "--vertical-correction: expected auto or an angle in degrees, got '" << value << "'");
+    return *deg;
+  }
+  const double deg = dataset.lidar_elevation_error_deg();
+  spdlog::info("{}: LiDAR elevation correction {} deg ({})", dataset.root(), deg,
+               dataset.lidar_elevation_error_source());
+  return deg;
+}
+
 DatasetFormat DetectDatasetFormat(const std::string& dir) {
   JVL_CHECK(IsDirectory(dir), dir << ": dataset folder not found");
   const fs::path p(dir);
@@ -250,7 +263,14 @@ class KittiOdometryDataset : public Dataset {
       ground_truth_files_ = {gt.string()};
     }
     id_ = "kitti:" + name + ":" + HashFiles(KeyFiles());
-    scans_motion_compensated_ = !SimulatedWithMotionDistortion((p / "sim" / "scene.json").string());
+    const std::string scene = (p / "sim" / "scene.json").string();
+    scans_motion_compensated_ = !SimulatedWithMotionDistortion(scene);
+    if (FileExists(scene)) {
+      lidar_elevation_error_source_ = "a simulated drive: its error is the simulator's own";
+    } else {
+      lidar_elevation_error_deg_ = kKittiLidarElevationErrorDeg;
+      lidar_elevation_error_source_ = "KITTI's HDL-64E, published";
+    }
   }
 
   PointCloud LoadScan(int64_t frame, size_t* dropped) const override {

@@ -68,6 +68,15 @@ class Dataset {
   // the image's, up to half a sweep period). Empty when every scan is taken at its frame's time
   // (the KITTI layouts, whose scans and images are triggered together).
   const std::vector<double>& scan_time_offsets() const { return scan_time_offsets_; }
+  // The published elevation error of the LiDAR that recorded the scans (deg): every return lies
+  // this much below its beam. KITTI odometry and KITTI raw (the same Velodyne HDL-64E): 0.205,
+  // the correction KISS-ICP's KITTI reader applies (IMLS-SLAM uses 0.22); on the KITTI 04
+  // excerpt it takes lidar_odom's pitch drift out (docs/lidar_odom.md). 0 where none is
+  // published: KITTI-360, Oxford, and every drive written by sim_sequence (sim/scene.json
+  // present), whose error is the simulator's own (docs/sim.md).
+  double lidar_elevation_error_deg() const { return lidar_elevation_error_deg_; }
+  // Where lidar_elevation_error_deg() comes from, for the log.
+  const char* lidar_elevation_error_source() const { return lidar_elevation_error_source_; }
   // scan_time_offsets()[index] in units of the frame period around frame `index` (the centred
   // difference of the timestamps, one-sided at the ends): the shift of the scan's time fractions
   // that de-skewing with a per-frame motion needs. 0 without offsets or with one frame.
@@ -98,6 +107,8 @@ class Dataset {
   Calibration calibration_;
   std::optional<Trajectory> ground_truth_;
   bool scans_motion_compensated_ = true;
+  double lidar_elevation_error_deg_ = 0.0;
+  const char* lidar_elevation_error_source_ = "none published for this layout";
   std::vector<double> scan_time_offsets_;
   std::vector<std::string> ground_truth_files_;  // the files ground_truth_ was read from
   std::string image_size_source_;                // where calibration_'s image size comes from
@@ -106,6 +117,18 @@ class Dataset {
 // --deskew of the tools that read scans: "on", "off" or "auto" (on exactly when the dataset's
 // scans are not motion-compensated). Logs the decision; throws on another value.
 bool ResolveDeskew(const std::string& mode, const Dataset& dataset);
+
+// The KITTI HDL-64E's published elevation error (deg); Dataset::lidar_elevation_error_deg().
+inline constexpr double kKittiLidarElevationErrorDeg = 0.205;
+// --vertical-correction of the tools that read scans: "auto" (the dataset's published error,
+// Dataset::lidar_elevation_error_deg(); the decision is logged) or an angle in degrees. Throws
+// a one-line error on another value.
+double ResolveVerticalCorrection(const std::string& value, const Dataset& dataset);
+// Help text of the tools' --vertical-correction option.
+inline constexpr const char* kVerticalCorrectionHelp =
+    "Elevation correction of every LiDAR return (deg): auto (the error published for the "
+    "dataset's LiDAR: 0.205 on KITTI odometry and raw scans, 0 elsewhere, simulated drives "
+    "included), or an angle (0 = off)";
 
 // Opens `dir` (format detected unless given) and selects the frames in `range`.
 std::unique_ptr<Dataset> OpenDataset(const std::string& dir,

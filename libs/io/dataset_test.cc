@@ -182,6 +182,30 @@ TEST_F(BadDatasetTest, MotionCompensationFromTheSimulatorsSceneAndDeskewModes) {
   EXPECT_TRUE(OpenDataset(seq_.string())->scans_motion_compensated());
 }
 
+// --vertical-correction auto: KITTI's published 0.205 deg on a KITTI odometry folder, none on a
+// sim_sequence folder of the same layout (its error is the simulator's own); a number is taken
+// as given, anything else is a one-line error.
+TEST_F(BadDatasetTest, VerticalCorrectionAutoIsKittisPublishedErrorAndNoneOnSimulatedDrives) {
+  const auto kitti = OpenDataset(seq_.string());
+  EXPECT_DOUBLE_EQ(kitti->lidar_elevation_error_deg(), 0.205);
+  EXPECT_DOUBLE_EQ(ResolveVerticalCorrection("auto", *kitti), 0.205);
+  EXPECT_DOUBLE_EQ(ResolveVerticalCorrection("0", *kitti), 0.0);
+  EXPECT_DOUBLE_EQ(ResolveVerticalCorrection("-0.12", *kitti), -0.12);
+  EXPECT_NE(ErrorOf([&] {
+              ResolveVerticalCorrection("on", *kitti);
+            }).find("--vertical-correction: expected auto or an angle in degrees, got 'on'"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ResolveVerticalCorrection("nan", *kitti); }).find("got 'nan'"),
+            std::string::npos);
+  fs::create_directories(seq_ / "sim");
+  std::ofstream((seq_ / "sim" / "scene.json").string())
+      << R"({"lidar": {"motion_distortion": false, "elevation_bias_deg": 0.12}})";
+  const auto simulated = OpenDataset(seq_.string());
+  EXPECT_DOUBLE_EQ(simulated->lidar_elevation_error_deg(), 0.0);
+  EXPECT_DOUBLE_EQ(ResolveVerticalCorrection("auto", *simulated), 0.0);
+  EXPECT_DOUBLE_EQ(ResolveVerticalCorrection("0.12", *simulated), 0.12);
+}
+
 TEST_F(BadDatasetTest, OddSizedBinNamesTheFile) {
   std::ofstream(Scan(1), std::ios::binary | std::ios::app) << "xyz";
   const auto ds = OpenDataset(seq_.string());

@@ -98,6 +98,8 @@ TEST_F(KittiRawTest, DetectsFormatAndReadsCalibration) {
   EXPECT_EQ(ds->LoadScan(3).size(), 1u);
   EXPECT_NEAR(ds->timestamps()[1], 0.1, 1e-6);
   EXPECT_NEAR(ds->timestamps()[9], 0.9, 1e-6);
+  // The same HDL-64E as the odometry sequences: --vertical-correction auto takes 0.205 deg.
+  EXPECT_DOUBLE_EQ(ds->lidar_elevation_error_deg(), 0.205);
 }
 
 TEST_F(KittiRawTest, OxtsGroundTruthFollowsTheKnownPath) {

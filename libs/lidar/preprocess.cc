@@ -88,12 +88,15 @@ void PreprocessOptions::Check() const {
 
 void CorrectVerticalAngle(double angle_rad, std::vector<Eigen::Vector3d>* velo_points) {
   if (angle_rad == 0) return;
-  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  // The rotation by angle_rad about the horizontal axis p x up (Rodrigues' formula with that
+  // axis orthogonal to p), written out: the horizontal part is scaled and the height raised, so
+  // each point costs one square root instead of an axis-angle matrix.
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
   for (Eigen::Vector3d& p : *velo_points) {
-    const Eigen::Vector3d axis = p.cross(up);
-    const double norm = axis.norm();
-    if (norm < 1e-9) continue;
-    p = Eigen::AngleAxisd(angle_rad, axis / norm) * p;
+    const double horizontal = std::sqrt(p.x() * p.x() + p.y() * p.y());
+    if (horizontal < 1e-9) continue;
+    const double scale = c - s * p.z() / horizontal;
+    p = Eigen::Vector3d(p.x() * scale, p.y() * scale, c * p.z() + s * horizontal);
   }
 }
 

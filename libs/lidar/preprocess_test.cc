@@ -97,6 +97,27 @@ TEST(PreprocessTest, VerticalCorrectionRaisesElevation) {
   EXPECT_NEAR(pts[1].norm(), std::sqrt(401.0), 1e-9);  // Range unchanged.
 }
 
+// The closed form equals the rotation about the horizontal axis p x up, in every direction; a
+// point on the vertical axis (no such axis) is left as it is.
+TEST(PreprocessTest, VerticalCorrectionIsTheRotationAboutTheHorizontalAxis) {
+  std::vector<Eigen::Vector3d> pts;
+  for (int a = 0; a < 12; ++a)
+    for (const double z : {-2.5, -0.3, 0.0, 0.8, 4.0}) {
+      const double az = a * M_PI / 6 + 0.1;
+      pts.emplace_back((5 + a) * std::cos(az), (5 + a) * std::sin(az), z);
+    }
+  pts.emplace_back(0, 0, 3);
+  for (const double angle : {0.205 * M_PI / 180, -0.5 * M_PI / 180}) {
+    std::vector<Eigen::Vector3d> corrected = pts;
+    CorrectVerticalAngle(angle, &corrected);
+    for (size_t i = 0; i + 1 < pts.size(); ++i) {
+      const Eigen::Vector3d axis = pts[i].cross(Eigen::Vector3d::UnitZ()).normalized();
+      EXPECT_LT((corrected[i] - Eigen::AngleAxisd(angle, axis) * pts[i]).norm(), 1e-12) << i;
+    }
+    EXPECT_EQ(corrected.back(), pts.back());
+  }
+}
+
 TEST(PreprocessTest, AzimuthTimeFraction) {
   EXPECT_NEAR(AzimuthTimeFraction({10, 0, 0}), 0.0, 1e-7);    // Forward: the frame time.
   EXPECT_NEAR(AzimuthTimeFraction({0, 10, 0}), -0.25, 1e-7);  // Left: a quarter turn before.

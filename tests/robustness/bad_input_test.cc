@@ -613,6 +613,7 @@ TEST_F(BadInputTest, InvalidOptions) {
               "too few to measure the calibration by");
   const std::string loops = "-d " + kSeq + " --poses " + In("odom.h5") + " -o " + Bad("l.h5");
   ExpectError("loop_detect", loops + " --every 0", "--every");
+  ExpectError("loop_detect", loops + " --vertical-correction 9", "--vertical-correction must be");
   ExpectError("loop_detect", loops + " --max-descriptor-distance 0",
               "--max-descriptor-distance must be in (0, 1]");
   ExpectError("loop_detect", loops + " --consistency 0", "--consistency must be >= 1");
@@ -647,6 +648,9 @@ TEST_F(BadInputTest, InvalidOptions) {
   ExpectError("lidar_odom", seq + " --voxel-size -1", "voxel");
   ExpectError("lidar_odom", seq + " --scan-map-size 0", "scan");
   ExpectError("lidar_odom", seq + " --log-level loud", "--log-level: unknown level 'loud'");
+  ExpectError("lidar_odom", seq + " --vertical-correction on",
+              "--vertical-correction: expected auto or an angle in degrees, got 'on'");
+  ExpectError("lidar_odom", seq + " --vertical-correction 30", "--vertical-correction must be");
   ExpectError("vp_detect", seq + " --canny-low 0", "--canny-low");
   ExpectError("vp_detect", seq + " --detector hough", "hough");
   ExpectError("vp_detect", seq + " --line-scale 0", "--line-scale must be in (0.05, 1]");
@@ -660,6 +664,8 @@ TEST_F(BadInputTest, InvalidOptions) {
       "Th_f");
   ExpectError("visual_assoc", seq + " --prior " + In("prior.h5") + " --orb-features 0", "orb");
   ExpectError("local_map", "--visual " + In("visual.h5") + seq + " --alpha 0", "alpha");
+  ExpectError("local_map", "--visual " + In("visual.h5") + seq + " --vertical-correction x",
+              "--vertical-correction: expected auto or an angle in degrees, got 'x'");
   ExpectError("local_map", "--visual " + In("visual.h5") + seq + " --samples-per-list 0",
               "--samples-per-list");
   const std::string global =

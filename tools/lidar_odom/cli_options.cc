@@ -1,10 +1,12 @@
 #include "cli_options.h"
 
 #include "app/option_group.h"
+#include "io/dataset.h"
 
 namespace jvl::tools {
 
-void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::string* deskew) {
+void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::string* deskew,
+                       std::string* vertical_correction) {
   lidar::OdometryOptions& o = *options;
   app::OptionGroup model(tool, "Model and sampling");
   model.Add("--scan-map-size", o.scan_map_size, "N: scans kept in the model (paper's N)");
@@ -23,8 +25,8 @@ void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::st
   auto& p = o.preprocess;
   pre.Add("--min-range", p.min_range, "Drop points closer than this (m)");
   pre.Add("--max-range", p.max_range, "Drop points further than this (m, 0 = no limit)");
-  pre.Add("--vertical-correction", "vertical_correction_deg", p.vertical_correction_deg,
-          "Elevation correction (deg; KITTI HDL-64: 0.205; 0 = off)");
+  pre.Add("--vertical-correction", "vertical_correction_deg", *vertical_correction,
+          io::kVerticalCorrectionHelp);
   pre.Add("--voxel-size", p.voxel_size, "Voxel downsampling of each scan (m, 0 = off)");
   pre.Add("--outlier-radius", p.outlier_radius, "RadiusOutlierRemoval radius (m, 0 = off)");
   pre.Add("--outlier-min-neighbors", p.outlier_min_neighbors,

@@ -8,7 +8,9 @@
 
 namespace jvl::tools {
 
-// `deskew`: the --deskew mode (auto, on, off), resolved against the dataset (io::ResolveDeskew).
-void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::string* deskew);
+// `deskew`: the --deskew mode (auto, on, off), resolved against the dataset (io::ResolveDeskew);
+// `vertical_correction`: auto or an angle, resolved by io::ResolveVerticalCorrection.
+void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::string* deskew,
+                       std::string* vertical_correction);
 
 }  // namespace jvl::tools

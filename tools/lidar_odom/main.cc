@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   jvl::io::DatasetOptions dataset_options;
   jvl::lidar::OdometryOptions options;
   std::string deskew = "auto";
+  std::string vertical_correction = "auto";
   auto& cli = tool.cli();
   cli.add_option("--dataset", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
@@ -50,13 +51,16 @@ int main(int argc, char** argv) {
   cli.add_option("--frames", frames, "Frame range A:B (B exclusive)")->capture_default_str();
   tool.OutputFile(cli.add_option("-o,--output", output, "Odometry artifact (.h5)")->required());
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses, "Also write KITTI pose text here"));
-  jvl::tools::AddLidarOdomFlags(tool, &options, &deskew);
+  jvl::tools::AddLidarOdomFlags(tool, &options, &deskew, &vertical_correction);
   return tool.Run(argc, argv, [&] {
     options.Check();
     const auto dataset =
         jvl::io::OpenDataset(dataset_dir, dataset_options, jvl::ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
     options.deskew = jvl::io::ResolveDeskew(deskew, *dataset);
+    options.preprocess.vertical_correction_deg =
+        jvl::io::ResolveVerticalCorrection(vertical_correction, *dataset);
+    options.Check();
     jvl::lidar::Odometry odometry(dataset->calibration().cam0_from_velo, options, tool.threads());
     jvl::io::OdometryArtifact artifact;
     const auto& ids = dataset->frames();

@@ -3,10 +3,12 @@
 #include <string>
 
 #include "app/option_group.h"
+#include "io/dataset.h"
 
 namespace jvl::tools {
 
-void AddLocalMapFlags(app::Tool& tool, mapping::LocalMappingOptions* o, mapping::ScanOptions* s) {
+void AddLocalMapFlags(app::Tool& tool, mapping::LocalMappingOptions* o, mapping::ScanOptions* s,
+                      std::string* vertical_correction) {
   app::OptionGroup method(tool, "Method");
   method.Add("--scan-map-size", o->scan_map_size,
              "N: S_model holds the keyframes within N frames of K_n (Sec. 4.2 step 2)");
@@ -35,9 +37,8 @@ void AddLocalMapFlags(app::Tool& tool, mapping::LocalMappingOptions* o, mapping:
 
   app::OptionGroup scan(tool, "Scans");
   scan.Add("--min-range", s->preprocess.min_range, "Drop points closer than this (m)");
-  scan.Add("--vertical-correction", "vertical_correction_deg",
-           s->preprocess.vertical_correction_deg,
-           "Elevation correction of every return (deg; KITTI HDL-64: 0.205; 0 = off)");
+  scan.Add("--vertical-correction", "vertical_correction_deg", *vertical_correction,
+           io::kVerticalCorrectionHelp);
   scan.Add("--voxel-size", s->preprocess.voxel_size, "Voxel downsampling of each scan (m)");
   scan.Add("--scan-voxel", "stored_voxel", s->stored_voxel,
            "Voxel of the scans stored in the artifact (m)");

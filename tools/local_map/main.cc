@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   std::string visual_path, dataset_dir, prior_path, output, kitti_poses;
   io::DatasetOptions dataset_options;
   std::string deskew = "auto";
+  std::string vertical_correction = "auto";
   mapping::LocalMappingOptions options;
   mapping::ScanOptions scan_options;
   auto& cli = tool.cli();
@@ -51,7 +52,7 @@ int main(int argc, char** argv) {
   tool.OutputFile(cli.add_option("-o,--output", output, "Output local.h5")->required());
   tool.OutputFile(cli.add_option("--kitti-poses", kitti_poses,
                                  "Also write the refined keyframes as KITTI text"));
-  tools::AddLocalMapFlags(tool, &options, &scan_options);
+  tools::AddLocalMapFlags(tool, &options, &scan_options, &vertical_correction);
   return tool.Run(argc, argv, [&] {
     options.Check();
     scan_options.Check();
@@ -75,6 +76,9 @@ int main(int argc, char** argv) {
     tool.AddDataset(*dataset, dataset_dir);
     const Rigid3d cam0_from_velo = dataset->calibration().cam0_from_velo;
     const bool deskew_scans = io::ResolveDeskew(deskew, *dataset);
+    scan_options.preprocess.vertical_correction_deg =
+        io::ResolveVerticalCorrection(vertical_correction, *dataset);
+    scan_options.Check();
     Progress progress("local_map", static_cast<int64_t>(input.size()), !tool.quiet());
     const mapping::LocalMappingResult result = mapping::RunLocalMapping(
         input,

@@ -155,6 +155,7 @@ int main(int argc, char** argv) {
   io::DatasetOptions dataset_options;
   loop::LidarLoopOptions options;
   loop::VisualLoopOptions visual_options;
+  std::string vertical_correction = "auto";
   CLI::App& cli = tool.cli();
   cli.add_option("--dataset,-d", dataset_dir, "Sequence folder (KITTI odometry/raw, synthetic)")
       ->required();
@@ -207,6 +208,8 @@ int main(int argc, char** argv) {
              "Accept a registration with an RMS IMLS distance up to this (m)");
   shared.Add("--min-correspondences", "min_correspondences", options.min_correspondences,
              "Accept a registration with at least this many correspondences");
+  shared.Add("--vertical-correction", "vertical_correction_deg", vertical_correction,
+             std::string(io::kVerticalCorrectionHelp) + "; the scans the registrations use");
   app::OptionGroup lidar(tool, "LiDAR detector");
   lidar.Add("--max-descriptor-distance", "max_descriptor_distance", options.max_descriptor_distance,
             "Verify the best candidate only below this descriptor distance (0 = identical, 1)");
@@ -248,6 +251,10 @@ int main(int argc, char** argv) {
     }
     const auto dataset = io::OpenDataset(dataset_dir, dataset_options, ParseFrameRange(frames));
     tool.AddDataset(*dataset, dataset_dir);
+    options.preprocess.vertical_correction_deg =
+        io::ResolveVerticalCorrection(vertical_correction, *dataset);
+    options.Check();
+    visual_options.lidar = options;
     tool.AddInput(poses_path);
     const Trajectory poses = io::ReadTrajectory(poses_path);
     const Trajectory keyframes = SelectKeyframes(poses, *dataset, every);
