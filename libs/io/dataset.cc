@@ -60,6 +60,16 @@ bool ResolveDeskew(const std::string& mode, const Dataset& dataset) {
   return deskew;
 }
 
+void Dataset::SetLidarElevationError(const std::string& scene_path, bool kitti_hdl64e) {
+  if (!scene_path.empty() && FileExists(scene_path)) {
+    lidar_elevation_error_deg_ = 0;
+    lidar_elevation_error_source_ = "a simulated drive: its error is the simulator's own";
+  } else if (kitti_hdl64e) {
+    lidar_elevation_error_deg_ = kKittiLidarElevationErrorDeg;
+    lidar_elevation_error_source_ = "KITTI's HDL-64E, published";
+  }
+}
+
 double ResolveVerticalCorrection(const std::string& value, const Dataset& dataset) {
   if (value != "auto") {
     const auto deg = ParseDouble(value);
@@ -265,12 +275,7 @@ class KittiOdometryDataset : public Dataset {
     id_ = "kitti:" + name + ":" + HashFiles(KeyFiles());
     const std::string scene = (p / "sim" / "scene.json").string();
     scans_motion_compensated_ = !SimulatedWithMotionDistortion(scene);
-    if (FileExists(scene)) {
-      lidar_elevation_error_source_ = "a simulated drive: its error is the simulator's own";
-    } else {
-      lidar_elevation_error_deg_ = kKittiLidarElevationErrorDeg;
-      lidar_elevation_error_source_ = "KITTI's HDL-64E, published";
-    }
+    SetLidarElevationError(scene, /*kitti_hdl64e=*/true);
   }
 
   PointCloud LoadScan(int64_t frame, size_t* dropped) const override {

@@ -100,6 +100,10 @@ class Dataset {
   std::vector<std::string> InputFiles() const;
 
  protected:
+  // Sets lidar_elevation_error_deg() and its source: none on a drive written by sim_sequence
+  // (`scene_path`, its sim/scene.json, exists), KITTI's published error when the recording's
+  // LiDAR is KITTI's HDL-64E (`kitti_hdl64e`), none otherwise.
+  void SetLidarElevationError(const std::string& scene_path, bool kitti_hdl64e);
   DatasetFormat format_ = DatasetFormat::kAuto;
   std::string root_, id_;
   std::vector<int64_t> frames_;

@@ -103,8 +103,7 @@ class Kitti360Dataset : public Dataset {
     // in its sim/scene.json whether the LiDAR moved during the sweep.
     const std::string scene = (root / "data_3d_raw" / drive_ / "sim" / "scene.json").string();
     scans_motion_compensated_ = FileExists(scene) && !SimulatedWithMotionDistortion(scene);
-    if (FileExists(scene))
-      lidar_elevation_error_source_ = "a simulated drive: its error is the simulator's own";
+    SetLidarElevationError(scene, /*kitti_hdl64e=*/false);
     image_root_ = root / "data_2d_raw" / drive_;
 
     // Calibration: rectified P of cameras 0 and 1 (the perspective pair), the rectified image

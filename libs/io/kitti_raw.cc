@@ -73,8 +73,7 @@ class KittiRawDataset : public Dataset {
   KittiRawDataset(const std::string& dir, const FrameRange& range) {
     format_ = DatasetFormat::kKittiRaw;
     scans_motion_compensated_ = false;  // the raw readme: points must be untwisted
-    lidar_elevation_error_deg_ = kKittiLidarElevationErrorDeg;  // the odometry scans' sensor
-    lidar_elevation_error_source_ = "KITTI's HDL-64E, published";
+    SetLidarElevationError(/*scene_path=*/"", /*kitti_hdl64e=*/true);  // the odometry scans' sensor
     root_ = dir;
     const fs::path p = fs::path(dir);
     const fs::path drive = p.filename().empty() ? p.parent_path() : p;

@@ -199,8 +199,7 @@ class OxfordDataset : public Dataset {
     // in its sim/scene.json whether the LiDAR moved during the sweep.
     const std::string scene = (p / "sim" / "scene.json").string();
     scans_motion_compensated_ = FileExists(scene) && !SimulatedWithMotionDistortion(scene);
-    if (FileExists(scene))
-      lidar_elevation_error_source_ = "a simulated drive: its error is the simulator's own";
+    SetLidarElevationError(scene, /*kitti_hdl64e=*/false);
     JVL_CHECK(IsOxfordTraversal(dir), dir << ": not an Oxford RobotCar traversal (expected "
                                              "stereo.timestamps and velodyne_left.timestamps)");
     const std::string cam_stamps = (p / "stereo.timestamps").string();
