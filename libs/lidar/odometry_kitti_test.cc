@@ -129,8 +129,21 @@ TEST(OdometryKittiTest, PublishedElevationCorrectionTakesOutThePitchDrift) {
   if (!std::filesystem::exists(kSequence)) GTEST_SKIP() << "KITTI 04 sample absent: " << kSequence;
   const RunSummary uncorrected = RunKitti("0:51", OdometryOptions(), false);
   const RunSummary corrected = RunKitti("0:51", OdometryOptions());
-  EXPECT_LT(uncorrected.end_pitch_error_deg, -0.3);         // -0.45 measured
-  EXPECT_LT(std::abs(corrected.end_pitch_error_deg), 0.1);  // +0.03 measured
+  EXPECT_LT(uncorrected.end_pitch_error_deg, -0.3);         // -0.40 measured
+  EXPECT_LT(std::abs(corrected.end_pitch_error_deg), 0.1);  // +0.035 measured
+}
+
+// The odometry keeps the small objects (cars, poles) that IMLS-SLAM removes: on the real excerpt
+// they make the registration more accurate (0.0278 -> 0.0221 m APE), below the 0.0257 m KISS-ICP
+// v1.2.3 reaches on the same frames (docs/performance.md).
+TEST(OdometryKittiTest, KeepingSmallObjectsIsTheDefaultAndMoreAccurate) {
+  if (!std::filesystem::exists(kSequence)) GTEST_SKIP() << "KITTI 04 sample absent: " << kSequence;
+  OdometryOptions removed;
+  removed.preprocess.remove_small_objects = true;
+  const RunSummary kept = RunKitti("0:51", OdometryOptions());
+  const RunSummary without = RunKitti("0:51", removed);
+  EXPECT_LT(kept.errors.ape_rmse, 0.025);                          // 0.0221 measured.
+  EXPECT_LT(kept.errors.ape_rmse, 0.9 * without.errors.ape_rmse);  // 0.0278 measured.
 }
 
 }  // namespace

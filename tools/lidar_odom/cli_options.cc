@@ -41,7 +41,8 @@ void AddLidarOdomFlags(app::Tool& tool, lidar::OdometryOptions* options, std::st
   pre.Add("--ground-samples", "ground_max_samples", p.ground_max_samples,
           "Points the ground RANSAC runs on");
   pre.Flag("--remove-small-objects,!--keep-small-objects", p.remove_small_objects,
-           "Drop clusters with a small bounding box (cars, pedestrians)");
+           "Drop clusters with a small bounding box (cars, pedestrians), as IMLS-SLAM does; off by "
+           "default: kept, they make the odometry more accurate (docs/lidar_odom.md)");
   pre.Add("--cluster-cell", p.cluster_cell, "Small-object clustering cell (m)");
   pre.Add("--small-object-horizontal", p.small_object_horizontal,
           "Clusters smaller than this along x and z (m) ...");
