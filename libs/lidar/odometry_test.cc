@@ -146,6 +146,13 @@ TEST(OdometryTest, CorridorFlaggedDegenerate) {
       << f.diagnostics.min_eigenvalue;
 }
 
+// The odometry keeps the small objects by default (odometry_kitti_test.cc measures why); the
+// preprocessing of local_map and loop_detect keeps IMLS-SLAM's removal.
+TEST(OdometryTest, KeepsSmallObjectsByDefault) {
+  EXPECT_FALSE(OdometryOptions().preprocess.remove_small_objects);
+  EXPECT_TRUE(PreprocessOptions().remove_small_objects);
+}
+
 TEST(OdometryTest, OptionsChecked) {
   OdometryOptions o;
   o.scan_map_size = 0;
