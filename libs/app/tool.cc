@@ -202,11 +202,13 @@ void Tool::AddDatasetOptions(io::DatasetOptions* options) {
   cli_.add_option("--gt-source", options->ground_truth, io::kDatasetGroundTruthHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"default", "ins", "radar"}));
+  cli_.add_option("--calib", options->calibration, io::kDatasetCalibrationHelp);
 }
 
 void Tool::AddDataset(const io::Dataset& dataset, const std::string& source) {
   SetDatasetId(dataset.id(), source);
   for (const std::string& f : dataset.KeyFiles()) AddInput(f);
+  if (!dataset.calibration_file().empty()) AddInput(dataset.calibration_file(), false);
   // Only outputs that already exist can be a dataset file; most runs skip the listing.
   bool any_exists = false;
   for (const CLI::Option* out : output_options_)

@@ -48,12 +48,13 @@ class Tool {
   // (--samples-per-list) if the tool has one, else the flag given here.
   void FieldFlag(const std::string& field, const std::string& flag);
 
-  // Adds the options every tool that opens a dataset has: --format, --lidar and --gt-source
-  // (io::DatasetOptions; the reader checks the values and the layout they apply to).
+  // Adds the options every tool that opens a dataset has: --format, --lidar, --gt-source and
+  // --calib (io::DatasetOptions; the reader checks the values and the layout they apply to).
   void AddDatasetOptions(io::DatasetOptions* options);
 
-  // Records a dataset as input: its sequence id (SetDatasetId), its key files (AddInput), and
-  // refuses an output that is one of the files the dataset's frames are read from.
+  // Records a dataset as input: its sequence id (SetDatasetId), its key files and the --calib
+  // file that replaced its calibration (AddInput), and refuses an output that is one of the
+  // files the dataset's frames are read from.
   void AddDataset(const io::Dataset& dataset, const std::string& source);
 
   // Records an input file (path, size, content hash) for the provenance. The dataset id in an

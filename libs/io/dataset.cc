@@ -318,8 +318,33 @@ void Dataset::CheckCamera(int camera) const {
   }
 }
 
+void Dataset::ReplaceCalibration(const std::string& path) {
+  JVL_CHECK(FileExists(path), "--calib " << path << ": file not found");
+  const Calibration file = ReadKittiCalibration(path);
+  Calibration replaced = calibration_;
+  for (int i = 0; i < 4; ++i) {
+    if (calibration_.P[static_cast<size_t>(i)].isZero()) continue;  // Not a camera of the dataset.
+    JVL_CHECK(!file.P[static_cast<size_t>(i)].isZero(),
+              "--calib " << path << ": no P" << i << ", but " << root_ << " has camera " << i);
+    file.CheckCamera(i, path);
+    replaced.P[static_cast<size_t>(i)] = file.P[static_cast<size_t>(i)];
+  }
+  replaced.cam0_from_velo = file.cam0_from_velo;
+  const double rotation_deg = RotationAngle(file.cam0_from_velo.rotation() *
+                                            calibration_.cam0_from_velo.rotation().inverse()) *
+                              180.0 / M_PI;
+  spdlog::info(
+      "{}: calibration from {} instead of the dataset's: its Tr differs by a rotation of {:.4f} "
+      "deg and a translation of {:.4f} m",
+      root_, path, rotation_deg,
+      (file.cam0_from_velo.translation() - calibration_.cam0_from_velo.translation()).norm());
+  calibration_ = replaced;
+  calibration_file_ = path;
+}
+
 std::vector<std::string> Dataset::InputFiles() const {
   std::vector<std::string> files = KeyFiles();
+  if (!calibration_file_.empty()) files.push_back(calibration_file_);
   files.insert(files.end(), ground_truth_files_.begin(), ground_truth_files_.end());
   for (const int64_t f : frames_) {
     files.push_back(ScanPath(f));
@@ -339,18 +364,11 @@ double Dataset::ScanTimeOffsetInFrames(size_t index) const {
   return period > 0 ? scan_time_offsets_[index] / period : 0;
 }
 
-std::unique_ptr<Dataset> OpenDataset(const std::string& dir, DatasetFormat format,
-                                     const FrameRange& range) {
-  DatasetOptions options;
-  options.format = DatasetFormatName(format);
-  return OpenDataset(dir, options, range);
-}
+namespace {
 
-std::unique_ptr<Dataset> OpenDataset(const std::string& dir, const DatasetOptions& options,
-                                     const FrameRange& range) {
-  DatasetFormat format = ParseDatasetFormat(options.format);
-  JVL_CHECK(IsDirectory(dir), dir << ": dataset folder not found");
-  if (format == DatasetFormat::kAuto) format = DetectDatasetFormat(dir);
+std::unique_ptr<Dataset> OpenDatasetOfFormat(const std::string& dir, DatasetFormat format,
+                                             const DatasetOptions& options,
+                                             const FrameRange& range) {
   if (format == DatasetFormat::kOxford) return OpenOxfordDataset(dir, options, range);
   JVL_CHECK(options.lidar == "default",
             "--lidar " << options.lidar << ": " << dir << " is a " << DatasetFormatName(format)
@@ -363,6 +381,25 @@ std::unique_ptr<Dataset> OpenDataset(const std::string& dir, const DatasetOption
   if (format == DatasetFormat::kKittiRaw) return OpenKittiRawDataset(dir, range);
   if (format == DatasetFormat::kKitti360) return OpenKitti360Dataset(dir, range);
   return std::make_unique<KittiOdometryDataset>(dir, range);
+}
+
+}  // namespace
+
+std::unique_ptr<Dataset> OpenDataset(const std::string& dir, DatasetFormat format,
+                                     const FrameRange& range) {
+  DatasetOptions options;
+  options.format = DatasetFormatName(format);
+  return OpenDataset(dir, options, range);
+}
+
+std::unique_ptr<Dataset> OpenDataset(const std::string& dir, const DatasetOptions& options,
+                                     const FrameRange& range) {
+  DatasetFormat format = ParseDatasetFormat(options.format);
+  JVL_CHECK(IsDirectory(dir), dir << ": dataset folder not found");
+  if (format == DatasetFormat::kAuto) format = DetectDatasetFormat(dir);
+  std::unique_ptr<Dataset> dataset = OpenDatasetOfFormat(dir, format, options, range);
+  if (!options.calibration.empty()) dataset->ReplaceCalibration(options.calibration);
+  return dataset;
 }
 
 }  // namespace jvl::io

@@ -29,14 +29,21 @@ inline constexpr const char* kCameraHelp =
 inline constexpr const char* kDatasetFormatHelp =
     "Dataset layout: auto (detected from the folder), kitti, kitti-raw, kitti360 or oxford";
 
-// What the tools pass to the readers (--format, --lidar, --gt-source; app::Tool::
-// AddDatasetOptions adds the three). "default" leaves the choice to the layout; an option other
+// What the tools pass to the readers (--format, --lidar, --gt-source, --calib; app::Tool::
+// AddDatasetOptions adds the four). "default" leaves the choice to the layout; an option other
 // than "default" on a layout that does not offer it is a one-line error naming the layout.
 struct DatasetOptions {
   std::string format = "auto";           // ParseDatasetFormat
   std::string lidar = "default";         // oxford: left (the default), right or both
   std::string ground_truth = "default";  // oxford: ins (the default when present) or radar
+  // A calib.txt (KITTI odometry format) whose P0-P3 and Tr replace the dataset's calibration
+  // (Dataset::ReplaceCalibration); empty: the dataset's own.
+  std::string calibration;
 };
+inline constexpr const char* kDatasetCalibrationHelp =
+    "calib.txt (KITTI odometry format: P0-P3, Tr) to use instead of the dataset's calibration, "
+    "e.g. the one calib_check --write-calib writes; any layout; the image size stays the "
+    "dataset's, and so does its id (empty: the dataset's own calibration)";
 inline constexpr const char* kDatasetLidarHelp =
     "LiDAR of an Oxford RobotCar traversal: left (the default), right, or both (the right sweep "
     "merged into the left one's frame); other layouts have one LiDAR and take only 'default'";
@@ -95,6 +102,14 @@ class Dataset {
   virtual std::string ImagePath(int64_t frame, int camera = 0) const = 0;
   // Key files that identify the content (calibration, times) for provenance.
   virtual std::vector<std::string> KeyFiles() const = 0;
+  // Replaces the calibration by the projections P0-P3 and Tr of the calib.txt at `path` (KITTI
+  // odometry format; DatasetOptions::calibration). Only the cameras the dataset has are taken,
+  // and each of them must be in the file; the image size is kept. The dataset's id does not
+  // change (it names the recording); the file is an input of the tools (calibration_file()).
+  // Logs how far the new Tr lies from the dataset's. Throws a one-line error naming the file.
+  void ReplaceCalibration(const std::string& path);
+  // The file ReplaceCalibration read, or empty.
+  const std::string& calibration_file() const { return calibration_file_; }
   // Every file the selected frames may be read from (key files, ground truth, the scans and the
   // images of cameras 0-3), whether present or not: what a tool must never overwrite.
   std::vector<std::string> InputFiles() const;
@@ -116,6 +131,7 @@ class Dataset {
   std::vector<double> scan_time_offsets_;
   std::vector<std::string> ground_truth_files_;  // the files ground_truth_ was read from
   std::string image_size_source_;                // where calibration_'s image size comes from
+  std::string calibration_file_;                 // ReplaceCalibration's file, or empty
 };
 
 // --deskew of the tools that read scans: "on", "off" or "auto" (on exactly when the dataset's

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -262,6 +263,39 @@ TEST_F(BadDatasetTest, MissingCalibrationAndUnknownLayout) {
 TEST_F(BadDatasetTest, CalibrationWithoutTr) {
   std::ofstream(seq_ / "calib.txt") << "P0: 700 0 600 0 0 700 180 0 0 0 1 0\n";
   const std::string msg = ErrorOf([&] { OpenDataset(seq_.string()); });
+  EXPECT_NE(msg.find("missing P1"), std::string::npos) << msg;
+}
+
+// --calib: another calib.txt's P0-P3 and Tr replace the folder's; the id (the recording) and
+// the image size stay, the file becomes an input, and a missing or malformed file is one line.
+TEST_F(BadDatasetTest, CalibrationFileReplacesTheDatasetsCalibration) {
+  const auto own = OpenDataset(seq_.string());
+  Calibration other = own->calibration();
+  other.P[0](0, 0) = other.P[0](1, 1) = 710;
+  other.cam0_from_velo =
+      Rigid3d(ExpSO3(Eigen::Vector3d(0.002, 0, 0)), Eigen::Vector3d(0, -0.08, 0));
+  const std::string path = (root_ / "calib_corrected.txt").string();
+  WriteKittiCalibration(path, other);
+  DatasetOptions options;
+  options.calibration = path;
+  const auto replaced = OpenDataset(seq_.string(), options);
+  EXPECT_EQ(replaced->id(), own->id());
+  EXPECT_EQ(replaced->calibration_file(), path);
+  EXPECT_TRUE(own->calibration_file().empty());
+  EXPECT_DOUBLE_EQ(replaced->calibration().Camera(0).fx, 710);
+  EXPECT_DOUBLE_EQ(own->calibration().Camera(0).fx, 700);
+  EXPECT_NEAR(RotationAngle(replaced->calibration().cam0_from_velo.rotation()), 0.002, 1e-9);
+  EXPECT_NEAR(replaced->calibration().cam0_from_velo.translation().y(), -0.08, 1e-9);
+  EXPECT_EQ(replaced->calibration().image_width, own->calibration().image_width);
+  const std::vector<std::string> inputs = replaced->InputFiles();
+  EXPECT_NE(std::find(inputs.begin(), inputs.end(), path), inputs.end());
+
+  options.calibration = (root_ / "nope.txt").string();
+  std::string msg = ErrorOf([&] { OpenDataset(seq_.string(), options); });
+  EXPECT_NE(msg.find("nope.txt: file not found"), std::string::npos) << msg;
+  std::ofstream(root_ / "bad.txt") << "P0: 700 0 600 0 0 700 180 0 0 0 1 0\n";
+  options.calibration = (root_ / "bad.txt").string();
+  msg = ErrorOf([&] { OpenDataset(seq_.string(), options); });
   EXPECT_NE(msg.find("missing P1"), std::string::npos) << msg;
 }
 

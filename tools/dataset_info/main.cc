@@ -47,6 +47,9 @@ int main(int argc, char** argv) {
                 cam.cy, c.image_width, c.image_height);
     const auto t = c.cam0_from_velo.translation();
     std::printf("cam0<-velo   t = (%.4f, %.4f, %.4f) m\n", t.x(), t.y(), t.z());
+    if (!ds->calibration_file().empty())
+      std::printf("calibration  %s (--calib, in place of the dataset's)\n",
+                  ds->calibration_file().c_str());
     if (ds->ground_truth()) {
       const auto& gt = *ds->ground_truth();
       double length = 0;
