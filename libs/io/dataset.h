@@ -103,8 +103,8 @@ class Dataset {
   // Key files that identify the content (calibration, times) for provenance.
   virtual std::vector<std::string> KeyFiles() const = 0;
   // Replaces the calibration by the projections P0-P3 and Tr of the calib.txt at `path` (KITTI
-  // odometry format; DatasetOptions::calibration). Only the cameras the dataset has are taken,
-  // and each of them must be in the file; the image size is kept. The dataset's id does not
+  // odometry format, all of P0-P3 and Tr; DatasetOptions::calibration). Only the projections of
+  // the cameras the dataset has are taken; the image size is kept. The dataset's id does not
   // change (it names the recording); the file is an input of the tools (calibration_file()).
   // Logs how far the new Tr lies from the dataset's. Throws a one-line error naming the file.
   void ReplaceCalibration(const std::string& path);
