@@ -319,7 +319,7 @@ void Dataset::CheckCamera(int camera) const {
 }
 
 void Dataset::ReplaceCalibration(const std::string& path) {
-  JVL_CHECK(FileExists(path), "--calib " << path << ": file not found");
+  JVL_CHECK(FileExists(path) && !IsDirectory(path), "--calib " << path << ": file not found");
   const Calibration file = ReadKittiCalibration(path);
   Calibration replaced = calibration_;
   for (int i = 0; i < 4; ++i) {

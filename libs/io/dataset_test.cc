@@ -290,8 +290,11 @@ TEST_F(BadDatasetTest, CalibrationFileReplacesTheDatasetsCalibration) {
   const std::vector<std::string> inputs = replaced->InputFiles();
   EXPECT_NE(std::find(inputs.begin(), inputs.end(), path), inputs.end());
 
-  options.calibration = (root_ / "nope.txt").string();
+  options.calibration = root_.string();  // A folder.
   std::string msg = ErrorOf([&] { OpenDataset(seq_.string(), options); });
+  EXPECT_NE(msg.find("file not found"), std::string::npos) << msg;
+  options.calibration = (root_ / "nope.txt").string();
+  msg = ErrorOf([&] { OpenDataset(seq_.string(), options); });
   EXPECT_NE(msg.find("nope.txt: file not found"), std::string::npos) << msg;
   std::ofstream(root_ / "bad.txt") << "P0: 700 0 600 0 0 700 180 0 0 0 1 0\n";
   options.calibration = (root_ / "bad.txt").string();

@@ -29,12 +29,14 @@ int main(int argc, char** argv) {
   tool.cli().add_flag("--check-images", check_images,
                       "Read every image of --camera and report the reading speed");
   tool.cli().add_option("--camera", camera, jvl::io::kCameraHelp)->capture_default_str();
-  tool.cli().add_option("--write-gt", write_gt,
-                        "Write the ground truth of the selected frames as the tools see it "
-                        "(world_from_cam0, KITTI text with frame numbers: what evaluate --gt "
-                        "takes, e.g. for KITTI-360, whose poses skip frames)");
+  tool.OutputFile(
+      tool.cli().add_option("--write-gt", write_gt,
+                            "Write the ground truth of the selected frames as the tools see it "
+                            "(world_from_cam0, KITTI text with frame numbers: what evaluate --gt "
+                            "takes, e.g. for KITTI-360, whose poses skip frames)"));
   return tool.Run(argc, argv, [&] {
     const auto ds = jvl::io::OpenDataset(dataset, dataset_options, jvl::ParseFrameRange(frames));
+    tool.AddDataset(*ds, dataset);  // Refuses a --write-gt that is one of the dataset's files.
     const auto& c = ds->calibration();
     const auto cam = c.Camera(0);
     std::printf("dataset      %s\nformat       %s\nid           %s\n", ds->root().c_str(),

@@ -62,6 +62,8 @@ int main(int argc, char** argv) {
       opened.back()->CheckCamera(camera);
       // Inputs, but no sequence id: a vocabulary serves every sequence.
       for (const std::string& f : opened.back()->KeyFiles()) tool.AddInput(f, false);
+      if (!opened.back()->calibration_file().empty())
+        tool.AddInput(opened.back()->calibration_file(), false);
       const auto& f = opened.back()->frames();
       for (size_t i = 0; i < f.size(); i += static_cast<size_t>(every))
         images.push_back({opened.back().get(), f[i]});
