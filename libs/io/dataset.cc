@@ -324,9 +324,7 @@ void Dataset::ReplaceCalibration(const std::string& path) {
   Calibration replaced = calibration_;
   for (int i = 0; i < 4; ++i) {
     if (calibration_.P[static_cast<size_t>(i)].isZero()) continue;  // Not a camera of the dataset.
-    JVL_CHECK(!file.P[static_cast<size_t>(i)].isZero(),
-              "--calib " << path << ": no P" << i << ", but " << root_ << " has camera " << i);
-    file.CheckCamera(i, path);
+    file.CheckCamera(i, path);  // The file's P_i is a projection (not all zero).
     replaced.P[static_cast<size_t>(i)] = file.P[static_cast<size_t>(i)];
   }
   replaced.cam0_from_velo = file.cam0_from_velo;
