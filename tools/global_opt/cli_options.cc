@@ -29,7 +29,11 @@ void AddGlobalOptFlags(app::Tool& tool, mapping::GlobalMappingOptions* o, Global
   method.Add("--function-tolerance", o->solve.function_tolerance,
              "LM stops when an iteration lowers the cost by less than this fraction");
   method.Add("--rounds", "rounds", o->rounds,
-             "Rounds of (fresh IMLS traversal at the current poses, LM solve)");
+             "Rounds of (fresh IMLS traversal at the current poses, LM solve); with "
+             "--round-tolerance, the most rounds");
+  method.Add("--round-tolerance", "round_tolerance_m", o->round_tolerance_m,
+             "Stop the rounds once one changed no keyframe-to-keyframe motion by more than "
+             "this (m; 0 = always --rounds rounds)");
   method.Add("--first-direction-round", o->first_direction_round,
              "Rounds before this one run without e_D (warm start; 0 = e_D in every round)");
   method

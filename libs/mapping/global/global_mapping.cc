@@ -150,6 +150,8 @@ void GlobalMappingOptions::Check() const {
   solve.Check();
   traversal.Check();
   JVL_CHECK(rounds >= 1, "rounds must be >= 1, got " << rounds);
+  JVL_CHECK(std::isfinite(round_tolerance_m) && round_tolerance_m >= 0,
+            "round_tolerance_m must be >= 0 (0 = every round), got " << round_tolerance_m);
   JVL_CHECK(first_direction_round >= 0,
             "first_direction_round must be >= 0, got " << first_direction_round);
   JVL_CHECK(std::isfinite(refit_outlier_deg) && refit_outlier_deg > 0 && refit_outlier_deg < 90,
@@ -964,21 +966,55 @@ std::optional<optim::ResidualStats> DirectionCostBefore(int round, const FixedTe
   return optim::EvaluateJointCost(built).direction;
 }
 
+// The first round after which the rounds may stop on GlobalMappingOptions::round_tolerance_m:
+// e_O enters in round 1 and e_D in first_direction_round, and both are in the last round.
+int MinStopRound(const GlobalMappingOptions& options) {
+  return std::max(1, options.first_direction_round);
+}
+
 // One Levenberg-Marquardt solve of the round's problem; only round 0's costs before and the
-// last round's after are evaluated (they are what the report gives).
-optim::JointSolveResult SolveRound(int round, int rounds, const optim::JointProblemInput& problem,
-                                   const optim::JointProblemOptions& joint,
-                                   optim::SolveOptions solve) {
+// costs after of each round that may be the last are evaluated (they are what the report gives).
+optim::JointSolveResult SolveRound(int round, int rounds, const GlobalMappingOptions& options,
+                                   const optim::JointProblemInput& problem,
+                                   const optim::JointProblemOptions& joint) {
+  optim::SolveOptions solve = options.solve;
   if (!solve.progress_label.empty())
     solve.progress_label += " round " + std::to_string(round + 1) + "/" + std::to_string(rounds);
   solve.evaluate_before = round == 0;
-  solve.evaluate_after = round == rounds - 1;
+  solve.evaluate_after = round == rounds - 1 ||
+                         (options.round_tolerance_m > 0 && round >= MinStopRound(options));
   return optim::OptimizeJoint(problem, joint, solve);
+}
+
+// Largest change (m) of a keyframe-to-keyframe motion between two solutions of the same
+// keyframes: |t(M_old^-1 M_new)| over the consecutive pairs, M = T_i^-1 T_i+1. It is what a
+// further round of re-association could still move (GlobalMappingOptions::round_tolerance_m).
+struct MotionChange {
+  double largest_m = 0;
+  size_t at = 0;  // the pair's first keyframe
+};
+MotionChange LargestMotionChange(const std::vector<Rigid3d>& old_poses,
+                                 const std::map<int64_t, Rigid3d>& new_poses) {
+  MotionChange out;
+  for (size_t i = 0; i + 1 < old_poses.size(); ++i) {
+    const Rigid3d old_motion = old_poses[i].Inverse() * old_poses[i + 1];
+    const Rigid3d new_motion = new_poses.at(static_cast<int64_t>(i)).Inverse() *
+                               new_poses.at(static_cast<int64_t>(i + 1));
+    const double change = (old_motion.Inverse() * new_motion).translation().norm();
+    if (change > out.largest_m) out = {change, i};
+  }
+  return out;
 }
 
 // The round's solution is the next round's start.
 void AcceptRound(DirectionTerm* direction, optim::JointProblemInput* problem,
                  GlobalMappingResult* result) {
+  const MotionChange change =
+      LargestMotionChange(result->keyframes.world_from_cam, result->solve.poses);
+  result->round_motion_change_m.push_back(change.largest_m);
+  spdlog::info("round {}: keyframe-to-keyframe motions changed by up to {:.2f} mm (frames {}-{})",
+               result->rounds, 1e3 * change.largest_m, result->keyframes.frames[change.at],
+               result->keyframes.frames[std::min(change.at + 1, result->keyframes.size() - 1)]);
   for (size_t i = 0; i < result->keyframes.size(); ++i)
     result->keyframes.world_from_cam[i] = result->solve.poses.at(static_cast<int64_t>(i));
   problem->map_points = result->solve.map_points;
@@ -1039,7 +1075,7 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
     SetImlsTerm(round, terms, options, &input, &problem, &result);
     SetOdometryTerm(round, input, options, &odometry, &problem, &result);
     const auto direction_before = DirectionCostBefore(round, terms, problem, joint, options);
-    result.solve = SolveRound(round, terms.rounds, problem, joint, options.solve);
+    result.solve = SolveRound(round, terms.rounds, options, problem, joint);
     if (joint.imls_pair_noise_max > 1.0 && result.solve.imls_blocks > 0)
       spdlog::info(
           "round {}: e_L noise per keyframe pair: median RMS residual {:.1f} mm, {} of {} pairs "
@@ -1064,6 +1100,13 @@ GlobalMappingResult OptimizeGlobal(GlobalMapInput input, const GlobalMappingOpti
       break;
     }
     AcceptRound(&direction, &problem, &result);
+    const double change = result.round_motion_change_m.back();
+    if (round + 1 < terms.rounds && round >= MinStopRound(options) &&
+        change < options.round_tolerance_m) {
+      spdlog::info("rounds: converged after {} (largest motion change {:.2f} mm < {:.2f} mm)",
+                   round + 1, 1e3 * change, 1e3 * options.round_tolerance_m);
+      break;
+    }
   }
   result.solve.before = before;  // report the costs at the input poses
   result.odometry_outliers =
@@ -1207,6 +1250,9 @@ nlohmann::json GlobalStatsJson(const GlobalMappingResult& r, const GlobalMapping
        {{"usable", s.usable},
         {"iterations", r.total_iterations},
         {"rounds", r.rounds},
+        {"max_rounds", o.rounds},
+        {"round_tolerance_m", o.round_tolerance_m},
+        {"round_motion_change_m", r.round_motion_change_m},
         {"last_round_iterations", s.iterations},
         {"time_s", s.time_s},
         {"termination", s.termination},
