@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The gains table of a pipelines/gains run (standard library only).
 
-    gains_table.py RUN_DIR [-o RUN_DIR/gains.md] [--json RUN_DIR/gains.json]
+    gains_table.py RUN_DIR [-o RUN_DIR/gains.md] [--json RUN_DIR/gains.json] [--plot FILE.png]
 
 For every drive RUN_DIR/NAME/base (Makefile.example outputs: metrics.json, without_directions.txt,
 with_directions.txt, and odom.txt there or in RUN_DIR/NAME/common; the ground truth is the dataset's poses file named in
@@ -14,6 +14,11 @@ Steps: the frame-to-frame error of an estimate at frame k is the translation nor
 of the prior is a frame whose error exceeds 5x the prior's median frame-to-frame error; it
 survives in a global result when the result's error at that frame still exceeds that threshold.
 The table lists the prior's worst step with the global results' errors at the same frame.
+
+--plot FILE.png (needs matplotlib) draws the steps before and after: every step of the prior on
+the simulated drives (the results' errors at it against the prior's, in thresholds), and the
+frame-to-frame errors around the prior's worst step and around the step the results come
+closest to keeping.
 """
 import argparse
 import json
@@ -131,6 +136,8 @@ def drive_row(run, name, dataset):
     steps = [k for k, e in enumerate(prior) if e > threshold]
     row["step_threshold_m"] = threshold
     row["prior_steps"] = len(steps)
+    row["steps"] = [{"frame": k, **{key: errors[key][k] for key in errors}} for k in steps]
+    row["_errors"] = errors  # for --plot; not written to the JSON
     for key in ("without", "with"):
         if key in errors:
             row[key]["surviving_steps"] = sum(1 for k in steps if errors[key][k] > threshold)
@@ -192,11 +199,67 @@ def write_markdown(rows, path):
     return text
 
 
+def plot_steps(rows, path):
+    """The steps before and after (see the module's docstring)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    sims = [r for r in rows if not r.get("missing") and r["alignment"] != "none" and r["steps"]]
+    if not sims:
+        print("gains_table: no steps of the prior on the simulated drives: no plot", file=sys.stderr)
+        return
+    fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
+    ax = axes[0]
+    for key, marker, color in (("without", "o", "tab:blue"), ("with", "s", "tab:red")):
+        xs = [s["prior"] / r["step_threshold_m"] for r in sims for s in r["steps"]]
+        ys = [s[key] / r["step_threshold_m"] for r in sims for s in r["steps"]]
+        ax.scatter(xs, ys, s=14, marker=marker, facecolors="none", edgecolors=color,
+                   label=f"{LABELS[[k for k, _ in LABELS].index(key)][1]} ({len(xs)} steps)")
+    ax.axhline(1.0, color="k", lw=0.8, ls="--", label="threshold (5x the prior's median)")
+    ax.set_xscale("log")
+    ax.set_xlabel("prior's frame-to-frame error at the step / threshold")
+    ax.set_ylabel("result's error at that frame / threshold")
+    ax.set_title("every step of the prior (%d simulated drives have steps)" % len(sims), fontsize=9)
+    ax.legend(fontsize=8)
+
+    def around(ax, r, step, title):
+        k = step["frame"]
+        lo, hi = max(0, k - 15), min(len(r["_errors"]["prior"]), k + 16)
+        frames = list(range(lo, hi))
+        for key, label in LABELS:
+            if key in r["_errors"]:
+                ax.plot(frames, [1e3 * r["_errors"][key][f] for f in frames], marker=".",
+                        label=label)
+        ax.axhline(1e3 * r["step_threshold_m"], color="k", lw=0.8, ls="--", label="threshold")
+        ax.axvline(k, color="0.6", lw=0.8)
+        ax.set_yscale("log")
+        ax.set_xlabel("frame")
+        ax.set_ylabel("frame-to-frame translation error (mm)")
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=8)
+
+    worst_prior = max(((r, s) for r in sims for s in r["steps"]),
+                      key=lambda rs: rs[1]["prior"] / rs[0]["step_threshold_m"])
+    worst_result = max(((r, s) for r in sims for s in r["steps"]),
+                       key=lambda rs: max(rs[1]["without"], rs[1]["with"]) /
+                       rs[0]["step_threshold_m"])
+    for ax, (r, s), what in ((axes[1], worst_prior, "the prior's worst step"),
+                             (axes[2], worst_result, "the step the results keep most of")):
+        around(ax, r, s, "%s: %s frame %d\n(prior %.1f, w.o. %.1f, w. %.1f mm)" % (
+            what, r["name"], s["frame"], 1e3 * s["prior"], 1e3 * s["without"], 1e3 * s["with"]))
+    fig.tight_layout()
+    tmp = path + ".tmp.png"
+    fig.savefig(tmp, dpi=90)
+    os.replace(tmp, path)
+    print(f"gains_table: wrote {path}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("run")
     parser.add_argument("-o", "--output")
     parser.add_argument("--json")
+    parser.add_argument("--plot", help="the steps before and after (PNG; needs matplotlib)")
     args = parser.parse_args()
     rows = []
     for name, dataset in read_spec(args.run):
@@ -206,9 +269,11 @@ def main():
             row["ratio_with_without"] = row["with"]["ape_m"] / row["without"]["ape_m"]
         rows.append(row)
     text = write_markdown(rows, args.output or os.path.join(args.run, "gains.md"))
+    if args.plot:
+        plot_steps(rows, args.plot)
     json_path = args.json or os.path.join(args.run, "gains.json")
     with open(json_path + ".tmp", "w") as f:
-        json.dump(rows, f, indent=1)
+        json.dump([{k: v for k, v in r.items() if k != "_errors"} for r in rows], f, indent=1)
     os.replace(json_path + ".tmp", json_path)
     sys.stdout.write(text)
     return 0 if any(not r.get("missing") for r in rows) else 1
