@@ -119,7 +119,7 @@ struct GlobalMappingOptions {
   // r - 1's poses and map points. 1 = the paper's single pass. 4: e_D in three rounds, each
   // re-associated at the last one's poses (docs/global_opt.md "Rounds": on the highway drives
   // of the gains table 2 -> 4 rounds took APE with direction priors 0.28-1.05 m down to
-  // 0.15-0.31 m; the urban and suburban drives and KITTI 04 moved by <= 2.1 mm).
+  // 0.15-0.31 m; the urban and suburban drives and KITTI 04 moved by <= 3.3 mm).
   int rounds = 4;
   // Rounds stop early (after e_O and e_D have entered) once a round changed no
   // keyframe-to-keyframe motion by more than this (m; 0 = always `rounds` rounds).

@@ -398,7 +398,8 @@ TEST(GlobalMapping, OdometryLocalNoiseWeighsASlidingStretchLess) {
 
 // The rounds stop once a round has changed no keyframe-to-keyframe motion by more than
 // round_tolerance_m, and never before e_O and e_D have entered (round 2 of the defaults); each
-// round's largest change is reported, and the rounds settle.
+// round's largest change is reported. In this toy the later rounds do not settle much (7.9,
+// 5.5, 5.3 and 5.6 mm when written): the first round moves the most.
 TEST(GlobalMapping, RoundsStopOnceTheMotionsSettle) {
   SyntheticGlobalOptions so;
   so.keyframes = 30;
