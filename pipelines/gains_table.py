@@ -214,7 +214,7 @@ def plot_steps(rows, path):
         xs = [s["prior"] / r["step_threshold_m"] for r in sims for s in r["steps"]]
         ys = [s[key] / r["step_threshold_m"] for r in sims for s in r["steps"]]
         ax.scatter(xs, ys, s=14, marker=marker, facecolors="none", edgecolors=color,
-                   label=f"{LABELS[[k for k, _ in LABELS].index(key)][1]} ({len(xs)} steps)")
+                   label=f"{dict(LABELS)[key]} ({len(xs)} steps)")
     ax.axhline(1.0, color="k", lw=0.8, ls="--", label="threshold (5x the prior's median)")
     ax.set_xscale("log")
     ax.set_xlabel("prior's frame-to-frame error at the step / threshold")

@@ -128,6 +128,16 @@ void EmulateSavedImls(testing::SyntheticGlobal* syn) {
   syn->input.saved_imls = TraverseImls(syn->input.keyframes, syn->input.scans, local, 2);
 }
 
+// The physically consistent world (true scans and keypoints) with a prior drifting 0.1 deg of
+// yaw per keyframe.
+SyntheticGlobalOptions ConsistentDrift(int keyframes) {
+  SyntheticGlobalOptions so;
+  so.keyframes = keyframes;
+  so.biased_local = false;
+  so.yaw_drift = 0.1 * M_PI / 180.0;
+  return so;
+}
+
 // An odometry of `truth`: each frame's motion with 1 mm of noise across the road (x, y; seeded),
 // then `perturb(frame, &translation)`.
 template <typename Perturb>
@@ -223,10 +233,7 @@ TEST(GlobalMapping, DirectionPriorsRemoveAYawDriftTheOtherTermsCannot) {
 // a slow error of e_D, so the estimated sigma is inflated as for correlated VP errors
 // (direction_rho) and e_D removes less than with the VP noise given (the test above).
 TEST(GlobalMapping, DirectionPriorsImproveOnAConsistentDriftingSequence) {
-  SyntheticGlobalOptions so;
-  so.keyframes = 60;
-  so.biased_local = false;
-  so.yaw_drift = 0.1 * M_PI / 180.0;
+  const SyntheticGlobalOptions so = ConsistentDrift(60);
   // e_D's share, without e_S (which removes much of the same drift, below) and with one e_L
   // sigma for every keyframe pair (the noise per pair removes much of it too). Two rounds, the
   // figures below were measured with: with the default 4 this toy's pair-noise cost grows
@@ -269,10 +276,7 @@ TEST(GlobalMapping, DirectionPriorsImproveOnAConsistentDriftingSequence) {
 // mean error and conflicts with the gauge keyframe; the free d_w does not (measured, see
 // docs/global_opt.md).
 TEST(GlobalMapping, FreeDirectionsBeatAFixedReestimate) {
-  SyntheticGlobalOptions so;
-  so.keyframes = 60;
-  so.biased_local = false;
-  so.yaw_drift = 0.1 * M_PI / 180.0;
+  const SyntheticGlobalOptions so = ConsistentDrift(60);
   GlobalMappingOptions refit = Quiet();
   refit.direction_source = GlobalMappingOptions::DirectionSource::kRefit;
   const auto fixed = RunAblation(so, refit);
@@ -284,10 +288,7 @@ TEST(GlobalMapping, FreeDirectionsBeatAFixedReestimate) {
 // sideways between two keyframes. Its motion makes the result locally smoother than the other
 // terms alone, and the gate leaves the jump out instead of pulling the result into it.
 TEST(GlobalMapping, OdometryTermSmoothsAndLeavesTheOdometrysStepOut) {
-  SyntheticGlobalOptions so;
-  so.keyframes = 30;
-  so.biased_local = false;
-  so.yaw_drift = 0.1 * M_PI / 180.0;
+  const SyntheticGlobalOptions so = ConsistentDrift(30);
   auto syn = MakeSyntheticGlobal(so);
   EmulateSavedImls(&syn);
   const int step_keyframe = 15;  // the jump lies between keyframes 15 and 16
@@ -401,10 +402,7 @@ TEST(GlobalMapping, OdometryLocalNoiseWeighsASlidingStretchLess) {
 // round's largest change is reported. In this toy the later rounds do not settle much (7.9,
 // 5.5, 5.3 and 5.6 mm when written): the first round moves the most.
 TEST(GlobalMapping, RoundsStopOnceTheMotionsSettle) {
-  SyntheticGlobalOptions so;
-  so.keyframes = 30;
-  so.biased_local = false;
-  so.yaw_drift = 0.1 * M_PI / 180.0;
+  const SyntheticGlobalOptions so = ConsistentDrift(30);
   auto syn = MakeSyntheticGlobal(so);
   EmulateSavedImls(&syn);
   GlobalMappingOptions o = Quiet();
