@@ -981,8 +981,8 @@ optim::JointSolveResult SolveRound(int round, int rounds, const GlobalMappingOpt
   if (!solve.progress_label.empty())
     solve.progress_label += " round " + std::to_string(round + 1) + "/" + std::to_string(rounds);
   solve.evaluate_before = round == 0;
-  solve.evaluate_after = round == rounds - 1 ||
-                         (options.round_tolerance_m > 0 && round >= MinStopRound(options));
+  solve.evaluate_after =
+      round == rounds - 1 || (options.round_tolerance_m > 0 && round >= MinStopRound(options));
   return optim::OptimizeJoint(problem, joint, solve);
 }
 
@@ -998,8 +998,8 @@ MotionChange LargestMotionChange(const std::vector<Rigid3d>& old_poses,
   MotionChange out;
   for (size_t i = 0; i + 1 < old_poses.size(); ++i) {
     const Rigid3d old_motion = old_poses[i].Inverse() * old_poses[i + 1];
-    const Rigid3d new_motion = new_poses.at(static_cast<int64_t>(i)).Inverse() *
-                               new_poses.at(static_cast<int64_t>(i + 1));
+    const Rigid3d new_motion =
+        new_poses.at(static_cast<int64_t>(i)).Inverse() * new_poses.at(static_cast<int64_t>(i + 1));
     const double change = (old_motion.Inverse() * new_motion).translation().norm();
     if (change > out.largest_m) out = {change, i};
   }

@@ -432,7 +432,7 @@ TEST(GlobalMapping, RoundsStopOnceTheMotionsSettle) {
         << "keyframe " << i;
   // A tolerance below every change runs all rounds.
   o.round_tolerance_m = 0.5 * *std::min_element(every.round_motion_change_m.begin(),
-                                               every.round_motion_change_m.end());
+                                                every.round_motion_change_m.end());
   EXPECT_EQ(OptimizeGlobal(syn.input, o).rounds, 4);
   o.round_tolerance_m = -1;
   EXPECT_THROW(OptimizeGlobal(syn.input, o), Error);
