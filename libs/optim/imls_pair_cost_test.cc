@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "core/check.h"
@@ -221,6 +222,54 @@ TEST(ImlsPairCost, PairNoiseRaisesTheSigmaOfRoughPairsOnly) {
     EXPECT_NEAR(cost_b[i], cost_a[i] / (f * f), 1e-7 * cost_a[i]) << "pair " << i;
   }
   EXPECT_NEAR(cost_b[2], cost_a[2] / 9.0, 1e-7 * cost_a[2]);
+}
+
+// The gauge's pairs keep one sigma whatever their residuals: with the free poses moved as a
+// whole away from the gauge, only those pairs are rough, and widening them would loosen the
+// gauge. The gauge is the fixed set, or the first keyframe when none is given.
+TEST(ImlsPairCost, PairNoiseLeavesTheGaugesPairsAtOneSigma) {
+  std::mt19937 rng(7);
+  JointProblemInput input;
+  input.camera = testing::MakeToyRoad(false).input.camera;
+  Rigid3d pose = RandomPose(rng, 0.1, 1.0);
+  for (int64_t k = 0; k < 6; ++k) {
+    input.poses[k] = pose;
+    pose = pose * RandomPose(rng, 0.02, 1.0);
+  }
+  // Pairs (k, k - 1): (1, 0) and (4, 3) rough (12 cm), the other three clean (2 cm).
+  for (int64_t k = 1; k < 6; ++k) {
+    const double off = k == 1 || k == 4 ? 0.12 : 0.02;
+    for (const auto& l : RandomPair(rng, input.poses[k], input.poses[k - 1], 400, off))
+      input.imls.push_back({k, k - 1, l.p_x, l.c_p_y, l.c_normal});
+  }
+  JointProblemOptions off, on;
+  on.imls_pair_noise_max = 3.0;
+  off.beta = on.beta = 1.0;
+  JointProblemInput fixed_three = input;
+  fixed_three.fixed = {3};
+  const JointProblem a = BuildJointProblem(input, off);
+  const JointProblem first = BuildJointProblem(input, on);         // gauge: keyframe 0
+  const JointProblem three = BuildJointProblem(fixed_three, on);  // gauge: keyframe 3
+  ASSERT_EQ(a.imls_blocks.size(), 5u);
+  std::vector<double> cost_a(5), cost_first(5), cost_three(5);
+  for (size_t i = 0; i < 5; ++i) {
+    ASSERT_TRUE(
+        a.problem->EvaluateResidualBlock(a.imls_blocks[i], false, &cost_a[i], nullptr, nullptr));
+    ASSERT_TRUE(first.problem->EvaluateResidualBlock(first.imls_blocks[i], false, &cost_first[i],
+                                                     nullptr, nullptr));
+    ASSERT_TRUE(three.problem->EvaluateResidualBlock(three.imls_blocks[i], false, &cost_three[i],
+                                                     nullptr, nullptr));
+  }
+  // Block i is pair (i + 1, i). Keyframe 0's pair (1, 0) is rough but keeps its sigma; the rough
+  // pair (4, 3) away from the gauge is widened to the cap (factor 3, cost / 9).
+  EXPECT_NEAR(cost_first[0], cost_a[0], 1e-9 * cost_a[0]);
+  EXPECT_NEAR(cost_first[3], cost_a[3] / 9.0, 1e-7 * cost_a[3]);
+  // With keyframe 3 fixed, its pairs (3, 2) and (4, 3) keep their sigma, and (1, 0) is widened.
+  EXPECT_NEAR(cost_three[2], cost_a[2], 1e-9 * cost_a[2]);
+  EXPECT_NEAR(cost_three[3], cost_a[3], 1e-9 * cost_a[3]);
+  EXPECT_NEAR(cost_three[0], cost_a[0] / 9.0, 1e-7 * cost_a[0]);
+  EXPECT_EQ(first.fixed, std::set<int64_t>{0});
+  EXPECT_EQ(three.fixed, std::set<int64_t>{3});
 }
 
 }  // namespace

@@ -258,9 +258,16 @@ void AddImls(const JointProblemInput& input, const JointProblemOptions& options,
       const double median = UpperMedian(rms);
       jp.imls_pair_median_rms_m = median;
       if (median > 0) {
-        for (size_t i = 0; i < rms.size(); ++i) {
-          factor[i] = std::clamp(rms[i] / median, 1.0, options.imls_pair_noise_max);
+        size_t i = 0;
+        for (const auto& [key, sum] : pairs) {
+          // The gauge's pairs keep one sigma: they are what ties the rest of the problem to the
+          // gauge. Once the free poses have moved as a whole (later rounds of global mapping
+          // start from the previous result), only the gauge's pairs show large residuals, and
+          // widening them would let the rest turn away from the gauge further.
+          const bool gauge = jp.fixed.count(key.first) || jp.fixed.count(key.second);
+          if (!gauge) factor[i] = std::clamp(rms[i] / median, 1.0, options.imls_pair_noise_max);
           if (factor[i] > 1.0) ++jp.imls_pairs_inflated;
+          ++i;
         }
       }
     }
@@ -409,6 +416,10 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
   std::unique_ptr<ceres::LossFunction> imls_loss(MakeLoss(jp.weights.beta, options.imls_huber));
   std::unique_ptr<ceres::LossFunction> direction_loss(
       MakeLoss(jp.weights.gamma, options.direction_huber));
+  // Gauge: the fixed keyframes, or the first one (six degrees of freedom; LiDAR fixes scale).
+  // Known before the terms are added: e_L's noise per pair treats the gauge's pairs apart.
+  jp.fixed = input.fixed;
+  if (jp.fixed.empty()) jp.fixed.insert(jp.poses.begin()->first);
   std::vector<std::pair<int64_t, int32_t>> visual_pairs;
   AddVisual(input, options, visual_loss.get(), jp, &visual_pairs);
   std::sort(visual_pairs.begin(), visual_pairs.end());
@@ -460,9 +471,6 @@ JointProblem BuildJointProblem(const JointProblemInput& input, const JointProble
     if (!jp.surface_blocks.empty()) surface_loss.release();
   }
 
-  // Gauge: the fixed keyframes, or the first one (six degrees of freedom; LiDAR fixes scale).
-  jp.fixed = input.fixed;
-  if (jp.fixed.empty()) jp.fixed.insert(jp.poses.begin()->first);
   for (int64_t id : jp.fixed) jp.problem->SetParameterBlockConstant(jp.poses.at(id).data());
   return jp;
 }

@@ -148,7 +148,8 @@ struct JointProblemOptions {
   // SumsImlsPerPair): a pair whose RMS point-to-surface residual at the initial poses is f times
   // the median pair's (f > 1) gets the sigma imls_sigma_m x min(f, imls_pair_noise_max). One
   // sigma for all pairs overstates what a rough surface (vegetation, clutter) tells: its
-  // residuals are larger at any pose. <= 1: one sigma for every pair.
+  // residuals are larger at any pose. The pairs of a fixed (gauge) keyframe always keep
+  // imls_sigma_m. <= 1: one sigma for every pair.
   double imls_pair_noise_max = 0.0;
   double direction_sigma_px = 1.0;  // e_D in pixels (image u; v too unless set below)
   // e_D's v (image row) component, when it has a noise of its own (> 0): on sloped roads the
