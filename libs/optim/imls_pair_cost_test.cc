@@ -248,7 +248,7 @@ TEST(ImlsPairCost, PairNoiseLeavesTheGaugesPairsAtOneSigma) {
   JointProblemInput fixed_three = input;
   fixed_three.fixed = {3};
   const JointProblem a = BuildJointProblem(input, off);
-  const JointProblem first = BuildJointProblem(input, on);         // gauge: keyframe 0
+  const JointProblem first = BuildJointProblem(input, on);        // gauge: keyframe 0
   const JointProblem three = BuildJointProblem(fixed_three, on);  // gauge: keyframe 3
   ASSERT_EQ(a.imls_blocks.size(), 5u);
   std::vector<double> cost_a(5), cost_first(5), cost_three(5);
