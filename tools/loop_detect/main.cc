@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <future>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -25,6 +26,7 @@
 #include "core/strings.h"
 #include "core/threads.h"
 #include "io/dataset.h"
+#include "io/files.h"
 #include "io/loops_io.h"
 #include "io/trajectory_io.h"
 #include "io/visual_io.h"
@@ -59,8 +61,10 @@ Trajectory SelectKeyframes(const Trajectory& poses, const io::Dataset& dataset, 
 // detector: -1 = every accepted loop; 0 / 1 / 2 = the loops that detector accepted. A detector
 // run after another verified only the queries left open: run it alone (--detectors) for its own
 // recall.
-void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
-                              double min_separation, int detector, const std::string& label) {
+// Returns the figures it logs (the --report entry of `label`).
+nlohmann::json ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
+                                        double min_separation, int detector,
+                                        const std::string& label) {
   Trajectory kf;
   for (const int64_t f : loops.keyframes) {
     const auto i = gt.IndexOf(f);
@@ -133,6 +137,17 @@ void ReportAgainstGroundTruth(const Trajectory& gt, const io::LoopsData& loops,
       label, accepted, right, pct(right, accepted), same, same_found, pct(same_found, same),
       opposite, opposite_found, pct(opposite_found, opposite), closed[1], stretches[1],
       pct(closed[1], stretches[1]), closed[2], stretches[2], pct(closed[2], stretches[2]));
+  return {{"detector", label},
+          {"accepted", accepted},
+          {"right", right},
+          {"revisits_same", same},
+          {"found_same", same_found},
+          {"revisits_opposite", opposite},
+          {"found_opposite", opposite_found},
+          {"stretches_same", stretches[1]},
+          {"closed_same", closed[1]},
+          {"stretches_opposite", stretches[2]},
+          {"closed_opposite", closed[2]}};
 }
 
 }  // namespace
@@ -147,7 +162,7 @@ int main(int argc, char** argv) {
                  "earlier image and then the scan registration, the others by registering the "
                  "two scans; every verified candidate, accepted or not, goes to the loops "
                  "artifact.");
-  std::string dataset_dir, frames = ":", poses_path, output, gt_path, csv, visual_path;
+  std::string dataset_dir, frames = ":", poses_path, output, gt_path, csv, visual_path, report;
   int every = 5;
   int scan_cache = 1024;
   std::vector<std::string> detectors = {"lidar", "visual", "proximity"};
@@ -201,6 +216,11 @@ int main(int argc, char** argv) {
   cli.add_option("--gt", gt_path,
                  "Ground-truth trajectory: report the revisits and the loops' recall and "
                  "precision in the log");
+  tool.OutputFile(cli.add_option(
+      "--report", report,
+      "With --gt: also write those figures as JSON (per detector in the order they ran, then "
+      "\"combined\": accepted and right loops, revisiting keyframes found in the same and the "
+      "opposite direction, revisit stretches closed; and the keyframes and candidates)"));
   app::OptionGroup shared(tool, "Every detector");
   shared.Add("--min-separation", "min_separation_m", options.min_separation_m,
              "Candidates lie at least this far back along the path (m)");
@@ -231,6 +251,7 @@ int main(int argc, char** argv) {
 
   return tool.Run(argc, argv, [&] {
     options.Check();
+    JVL_CHECK(report.empty() || !gt_path.empty(), "--report needs --gt");
     const bool use_lidar =
         std::find(detectors.begin(), detectors.end(), "lidar") != detectors.end();
     const bool use_visual =
@@ -393,17 +414,28 @@ int main(int argc, char** argv) {
                  data.keyframes.size(), data.loops.size(), accepted, output);
     if (!gt_path.empty()) {
       const Trajectory gt = io::ReadTrajectory(gt_path);
+      nlohmann::json detectors_json = nlohmann::json::array();
       // The detectors in the order they ran; a later one verified only the queries left open.
-      if (use_visual) ReportAgainstGroundTruth(gt, data, options.min_separation_m, 1, "visual");
+      if (use_visual)
+        detectors_json.push_back(
+            ReportAgainstGroundTruth(gt, data, options.min_separation_m, 1, "visual"));
       if (use_lidar)
-        ReportAgainstGroundTruth(gt, data, options.min_separation_m, 0,
-                                 use_visual ? "LiDAR (after visual)" : "LiDAR");
+        detectors_json.push_back(ReportAgainstGroundTruth(
+            gt, data, options.min_separation_m, 0, use_visual ? "LiDAR (after visual)" : "LiDAR"));
       if (use_proximity)
-        ReportAgainstGroundTruth(
+        detectors_json.push_back(ReportAgainstGroundTruth(
             gt, data, options.min_separation_m, 2,
-            use_visual || use_lidar ? "proximity (after the others)" : "proximity");
+            use_visual || use_lidar ? "proximity (after the others)" : "proximity"));
       if (use_lidar + use_visual + use_proximity > 1)
-        ReportAgainstGroundTruth(gt, data, options.min_separation_m, -1, "combined");
+        detectors_json.push_back(
+            ReportAgainstGroundTruth(gt, data, options.min_separation_m, -1, "combined"));
+      if (!report.empty()) {
+        const nlohmann::json body = {{"keyframes", data.keyframes.size()},
+                                     {"candidates", data.loops.size()},
+                                     {"accepted", accepted},
+                                     {"detectors", detectors_json}};
+        io::WriteTextFileAtomic(report, body.dump(1) + "\n");
+      }
     }
   });
 }
