@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
 
 #include "lidar/surface.h"
 
@@ -126,6 +129,57 @@ TEST(ImlsTest, SlidingWindowAnswersAsAFreshModel) {
   EXPECT_TRUE(window.Project(back_pts[10], 0.15, 0.3, &p));
   EXPECT_EQ(p.nearest_scan, 1000);
   EXPECT_FALSE(window.Project(scan(50).first[10], 0.15, 0.3, &p));  // Removed long ago.
+}
+
+// A query visits the cells within the radius of x: it finds what a model of one cell holding
+// every point finds (the same count, nearest point and normal, the same weighted mean up to the
+// order of the sums), near cell faces, edges and corners, for a radius of one cell and of 1.5
+// cells (5 x 5 x 5 cells), and 3 km from the origin, where the stored single-precision points are
+// rounded to 0.1 mm.
+TEST(ImlsTest, QueriesFindWhatOneCellOfEveryPointFinds) {
+  for (const double offset : {0.0, 3000.0}) {
+    for (const double radius : {0.3, 0.45}) {
+      std::mt19937 rng(11);
+      std::uniform_real_distribution<double> u(-1.0, 1.0);
+      const Eigen::Vector3d origin(offset, -0.5 * offset, 0.1 * offset);
+      std::vector<Eigen::Vector3d> pts, normals;
+      for (int i = 0; i < 4000; ++i) {
+        const double a = u(rng), b = u(rng), c = u(rng);
+        pts.push_back(origin + Eigen::Vector3d(a, b, 0.3 * c));
+        const double nx = u(rng), ny = u(rng);
+        normals.push_back(Eigen::Vector3d(0.2 * nx, 0.2 * ny, 1.0).normalized());
+      }
+      ImlsModel model(0.3), one_cell(1e4);
+      model.AddScan(0, pts, normals);
+      one_cell.AddScan(0, pts, normals);
+      const double h = 0.15;
+      int found = 0, missed = 0;
+      for (int q = 0; q < 3000; ++q) {
+        const double a = u(rng), b = u(rng), c = u(rng);
+        Eigen::Vector3d x = origin + Eigen::Vector3d(a, b, 0.8 * c);  // points: |z| <= 0.3
+        // Half the queries within 1 mm of the grid's faces, edges and corners.
+        for (int axis = 0; axis < 3 && q % 2 == 0; ++axis) {
+          const double jitter = 0.001 * u(rng);
+          if (q % (4 + 2 * axis) == 0) x[axis] = 0.3 * std::round(x[axis] / 0.3) + jitter;
+        }
+        ASSERT_EQ(model.HasNeighbor(x, radius), one_cell.HasNeighbor(x, radius)) << q;
+        ImlsProjection p, all;
+        const bool hit = model.Project(x, h, radius, &p);
+        ASSERT_EQ(hit, one_cell.Project(x, h, radius, &all)) << q;
+        if (!hit) {
+          ++missed;
+          continue;
+        }
+        ++found;
+        EXPECT_EQ(p.neighbors, all.neighbors) << q;
+        EXPECT_EQ(p.nearest, all.nearest) << q;
+        EXPECT_EQ(p.normal, all.normal) << q;
+        EXPECT_NEAR(p.distance, all.distance, 1e-12) << q;
+      }
+      EXPECT_GT(found, 1000) << radius;
+      EXPECT_GT(missed, 10) << radius;  // queries far from every point too
+    }
+  }
 }
 
 TEST(SurfaceTest, NormalsAndPlanarityOfAPlaneAndALine) {
