@@ -20,6 +20,7 @@ SPEC = os.path.join(DATA, "small.spec")
 JOBS_PY = os.path.join(ROOT, "pipelines", "jobs.py")
 COLLECT_PY = os.path.join(ROOT, "pipelines", "collect.py")
 GAINS_PY = os.path.join(ROOT, "pipelines", "gains_table.py")
+LOOPS_PY = os.path.join(ROOT, "pipelines", "loops_table.py")
 FIDELITY_PY = os.path.join(ROOT, "scripts", "sim_fidelity.py")
 SLOW_BIAS_PY = os.path.join(ROOT, "scripts", "vp_slow_bias.py")
 SENSOR_FIDELITY_PY = os.path.join(ROOT, "scripts", "sensor_fidelity.py")
@@ -330,6 +331,71 @@ class GainsTable(unittest.TestCase):
         self.assertAlmostEqual(d1["worst_step"]["without_m"], 0.1, places=6)
         self.assertTrue(rows[1]["missing"])
         self.assertIn("| d1 | 21 | 0.02 |", read(os.path.join(self.run_dir, "gains.md")))
+
+
+class LoopsTable(unittest.TestCase):
+    """pipelines/loops_table.py on a hand-made run: APE ratios with / without loops, precision
+    and recall per detector, time per keyframe, a missing detector run."""
+
+    def setUp(self):
+        self.run_dir = tempfile.mkdtemp()
+        poses = os.path.join(self.run_dir, "data", "d1", "poses")
+        os.makedirs(poses)
+        with open(os.path.join(poses, "00.txt"), "w") as f:
+            f.writelines(kitti_line(0.0, 2.0 * i) for i in range(11))  # 20 m
+
+        def metrics(folder, without, with_):
+            os.makedirs(folder)
+            def estimate(label, ape):
+                return {"label": label, "ape": {"translation_m": {"rmse": ape},
+                                                "rotation_deg": {"rmse": ape / 10}},
+                        "kitti": {"t_rel_percent": ape / 100}}
+            with open(os.path.join(folder, "metrics.json"), "w") as f:
+                json.dump({"options": {"alignment": "se3"},
+                           "estimates": [estimate("prior", 1.0),
+                                         estimate("w.o. direction priors", without),
+                                         estimate("w. direction priors", with_)]}, f)
+        metrics(os.path.join(self.run_dir, "d1", "base"), 0.4, 0.2)
+        metrics(os.path.join(self.run_dir, "d1", "loops-1"), 0.1, 0.08)
+        gt = os.path.join(self.run_dir, "d1", "gt")
+        os.makedirs(gt)
+
+        def report(name, entries, time_s):
+            with open(os.path.join(gt, name + ".json"), "w") as f:
+                json.dump({"keyframes": 50, "candidates": 30, "accepted": entries[-1][1],
+                           "detectors": [
+                               {"detector": label, "accepted": a, "right": r,
+                                "revisits_same": 20, "found_same": fs, "revisits_opposite": 10,
+                                "found_opposite": fo, "stretches_same": 1, "closed_same": 1,
+                                "stretches_opposite": 1, "closed_opposite": 1 if fo else 0}
+                               for label, a, r, fs, fo in entries]}, f)
+            with open(os.path.join(gt, name + ".time"), "w") as f:
+                f.write(f"{time_s}\n")
+        report("visual", [("visual", 18, 18, 18, 0)], 1.5)
+        report("lidar", [("LiDAR", 12, 11, 10, 1)], 1.0)
+        report("all", [("visual", 18, 18, 18, 0), ("LiDAR (after visual)", 1, 1, 1, 0),
+                       ("combined", 27, 27, 19, 8)], 2.0)  # proximity.json: missing
+
+    def tearDown(self):
+        shutil.rmtree(self.run_dir)
+
+    def test_ratios_precision_recall_and_time(self):
+        out = run([sys.executable, LOOPS_PY, self.run_dir, "d1"])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        d1 = json.loads(read(os.path.join(self.run_dir, "loops.json")))[0]
+        self.assertAlmostEqual(d1["ratio_without"], 0.25)
+        self.assertAlmostEqual(d1["ratio_with"], 0.4)
+        self.assertAlmostEqual(d1["length_m"], 20.0)
+        self.assertEqual(d1["detectors"]["all"]["detector"], "combined")
+        self.assertIsNone(d1["detectors"]["proximity"])
+        md = read(os.path.join(self.run_dir, "loops.md"))
+        self.assertIn("| d1 | 11 | 0.02 | 1.000 / 0.100 |", md)
+        self.assertIn("| d1 | LiDAR | 50 | 30 | 12 / 11 (92 %) | 10 of 20 (50 %) | 1 of 10 (10 %)", md)
+        self.assertIn("| d1 | combined | 50 | 30 | 27 / 27 (100 %) | 19 of 20 (95 %) "
+                      "| 8 of 10 (80 %) | 1 of 1 / 1 of 1 | 2.0 (40) |", md)
+        self.assertIn("| d1 | proximity | missing |", md)
+        self.assertIn("0.25-0.40 (mean 0.32); wrong accepted loops (all runs of the second "
+                      "table) 1.", md)
 
 
 class SimFidelity(unittest.TestCase):
