@@ -174,11 +174,10 @@ TEST(ImlsPairCost, JointProblemWithPairBlocksReachesTheSameSolution) {
   EXPECT_THROW(BuildJointProblem(split, huber), Error);
 }
 
-// imls_pair_noise_max: a pair whose residuals are f times the median pair's gets the sigma x
-// min(f, max), i.e. its block cost / min(f, max)^2; the other pairs keep theirs. Off (<= 1),
-// every block is as before.
-TEST(ImlsPairCost, PairNoiseRaisesTheSigmaOfRoughPairsOnly) {
-  std::mt19937 rng(5);
+// Six keyframes k = 0..5 in a chain and the 400 correspondences of each pair (k, k - 1), with
+// points up to 12 cm off the surface for k in `rough`, 2 cm for the others.
+JointProblemInput PairChain(unsigned seed, const std::set<int64_t>& rough) {
+  std::mt19937 rng(seed);
   JointProblemInput input;
   input.camera = testing::MakeToyRoad(false).input.camera;
   Rigid3d pose = RandomPose(rng, 0.1, 1.0);
@@ -186,12 +185,30 @@ TEST(ImlsPairCost, PairNoiseRaisesTheSigmaOfRoughPairsOnly) {
     input.poses[k] = pose;
     pose = pose * RandomPose(rng, 0.02, 1.0);
   }
-  // Pairs (k, k - 1): four with points up to 2 cm off the surface, one rough (12 cm: 6x).
   for (int64_t k = 1; k < 6; ++k) {
-    const double off = k == 3 ? 0.12 : 0.02;
+    const double off = rough.count(k) ? 0.12 : 0.02;
     for (const auto& l : RandomPair(rng, input.poses[k], input.poses[k - 1], 400, off))
       input.imls.push_back({k, k - 1, l.p_x, l.c_p_y, l.c_normal});
   }
+  return input;
+}
+
+// The cost of each e_L block of `jp`, in block order.
+std::vector<double> ImlsBlockCosts(const JointProblem& jp) {
+  std::vector<double> costs(jp.imls_blocks.size());
+  for (size_t i = 0; i < costs.size(); ++i) {
+    EXPECT_TRUE(
+        jp.problem->EvaluateResidualBlock(jp.imls_blocks[i], false, &costs[i], nullptr, nullptr));
+  }
+  return costs;
+}
+
+// imls_pair_noise_max: a pair whose residuals are f times the median pair's gets the sigma x
+// min(f, max), i.e. its block cost / min(f, max)^2; the other pairs keep theirs. Off (<= 1),
+// every block is as before.
+TEST(ImlsPairCost, PairNoiseRaisesTheSigmaOfRoughPairsOnly) {
+  // Pairs (k, k - 1): four with points up to 2 cm off the surface, one rough (12 cm: 6x).
+  const JointProblemInput input = PairChain(5, {3});
   JointProblemOptions off, on;
   on.imls_pair_noise_max = 3.0;
   off.beta = on.beta = 1.0;
@@ -200,14 +217,9 @@ TEST(ImlsPairCost, PairNoiseRaisesTheSigmaOfRoughPairsOnly) {
   ASSERT_EQ(a.imls_blocks.size(), 5u);
   ASSERT_EQ(b.imls_blocks.size(), 5u);
   // Each pair's RMS from its block cost without the option: cost = 0.5 sum r^2 / sigma^2.
-  std::vector<double> cost_a(5), cost_b(5), rms(5);
-  for (size_t i = 0; i < 5; ++i) {
-    ASSERT_TRUE(
-        a.problem->EvaluateResidualBlock(a.imls_blocks[i], false, &cost_a[i], nullptr, nullptr));
-    ASSERT_TRUE(
-        b.problem->EvaluateResidualBlock(b.imls_blocks[i], false, &cost_b[i], nullptr, nullptr));
-    rms[i] = std::sqrt(2.0 * cost_a[i] / 400.0) * off.imls_sigma_m;
-  }
+  const std::vector<double> cost_a = ImlsBlockCosts(a), cost_b = ImlsBlockCosts(b);
+  std::vector<double> rms(5);
+  for (size_t i = 0; i < 5; ++i) rms[i] = std::sqrt(2.0 * cost_a[i] / 400.0) * off.imls_sigma_m;
   std::vector<double> sorted = rms;
   std::sort(sorted.begin(), sorted.end());
   const double median = sorted[2];
@@ -228,20 +240,8 @@ TEST(ImlsPairCost, PairNoiseRaisesTheSigmaOfRoughPairsOnly) {
 // whole away from the gauge, only those pairs are rough, and widening them would loosen the
 // gauge. The gauge is the fixed set, or the first keyframe when none is given.
 TEST(ImlsPairCost, PairNoiseLeavesTheGaugesPairsAtOneSigma) {
-  std::mt19937 rng(7);
-  JointProblemInput input;
-  input.camera = testing::MakeToyRoad(false).input.camera;
-  Rigid3d pose = RandomPose(rng, 0.1, 1.0);
-  for (int64_t k = 0; k < 6; ++k) {
-    input.poses[k] = pose;
-    pose = pose * RandomPose(rng, 0.02, 1.0);
-  }
   // Pairs (k, k - 1): (1, 0) and (4, 3) rough (12 cm), the other three clean (2 cm).
-  for (int64_t k = 1; k < 6; ++k) {
-    const double off = k == 1 || k == 4 ? 0.12 : 0.02;
-    for (const auto& l : RandomPair(rng, input.poses[k], input.poses[k - 1], 400, off))
-      input.imls.push_back({k, k - 1, l.p_x, l.c_p_y, l.c_normal});
-  }
+  const JointProblemInput input = PairChain(7, {1, 4});
   JointProblemOptions off, on;
   on.imls_pair_noise_max = 3.0;
   off.beta = on.beta = 1.0;
@@ -251,15 +251,10 @@ TEST(ImlsPairCost, PairNoiseLeavesTheGaugesPairsAtOneSigma) {
   const JointProblem first = BuildJointProblem(input, on);        // gauge: keyframe 0
   const JointProblem three = BuildJointProblem(fixed_three, on);  // gauge: keyframe 3
   ASSERT_EQ(a.imls_blocks.size(), 5u);
-  std::vector<double> cost_a(5), cost_first(5), cost_three(5);
-  for (size_t i = 0; i < 5; ++i) {
-    ASSERT_TRUE(
-        a.problem->EvaluateResidualBlock(a.imls_blocks[i], false, &cost_a[i], nullptr, nullptr));
-    ASSERT_TRUE(first.problem->EvaluateResidualBlock(first.imls_blocks[i], false, &cost_first[i],
-                                                     nullptr, nullptr));
-    ASSERT_TRUE(three.problem->EvaluateResidualBlock(three.imls_blocks[i], false, &cost_three[i],
-                                                     nullptr, nullptr));
-  }
+  const std::vector<double> cost_a = ImlsBlockCosts(a), cost_first = ImlsBlockCosts(first),
+                            cost_three = ImlsBlockCosts(three);
+  ASSERT_EQ(cost_first.size(), 5u);
+  ASSERT_EQ(cost_three.size(), 5u);
   // Block i is pair (i + 1, i). Keyframe 0's pair (1, 0) is rough but keeps its sigma; the rough
   // pair (4, 3) away from the gauge is widened to the cap (factor 3, cost / 9).
   EXPECT_NEAR(cost_first[0], cost_a[0], 1e-9 * cost_a[0]);
