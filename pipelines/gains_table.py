@@ -87,6 +87,22 @@ def figure(estimate, *path):
     return v
 
 
+def path_length(poses):
+    """Length (m) of the path through the positions of KITTI poses."""
+    positions = [[T[i][3] for i in range(3)] for T in poses]
+    return sum(math.dist(a, b) for a, b in zip(positions, positions[1:]))
+
+
+def estimate_figures(e):
+    """APE translation / rotation RMSE, t_rel and r_rel of one estimate of metrics.json."""
+    return {
+        "ape_m": figure(e, "ape", "translation_m", "rmse"),
+        "ape_deg": figure(e, "ape", "rotation_deg", "rmse"),
+        "t_rel": figure(e, "kitti", "t_rel_percent"),
+        "r_rel": figure(e, "kitti", "r_rel_deg_per_100m"),
+    }
+
+
 def read_spec(run):
     drives = []
     with open(os.path.join(run, "gains.spec")) as f:
@@ -114,21 +130,14 @@ def drive_row(run, name, dataset):
     # The ground truth of a dataset excerpt (KITTI 04 frames 0-50) covers the whole sequence.
     gt = gt[:len(read_kitti(prior_path))]
     row["frames"] = len(gt)
-    row["length_m"] = sum(
-        math.dist([gt[k][i][3] for i in range(3)], [gt[k + 1][i][3] for i in range(3)])
-        for k in range(len(gt) - 1))
+    row["length_m"] = path_length(gt)
     errors = {}
     for key, label in LABELS:
         e = by_label.get(label)
         if e is None:
             row[key] = None
             continue
-        row[key] = {
-            "ape_m": figure(e, "ape", "translation_m", "rmse"),
-            "ape_deg": figure(e, "ape", "rotation_deg", "rmse"),
-            "t_rel": figure(e, "kitti", "t_rel_percent"),
-            "r_rel": figure(e, "kitti", "r_rel_deg_per_100m"),
-        }
+        row[key] = estimate_figures(e)
         path = prior_path if key == "prior" else os.path.join(folder, FILES[key])
         errors[key] = frame_errors(gt, read_kitti(path))
     prior = errors.get("prior", [])

@@ -14,12 +14,11 @@ keyframe.
 """
 import argparse
 import json
-import math
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gains_table import LABELS, figure, fmt, read_kitti  # noqa: E402
+from gains_table import LABELS, estimate_figures, fmt, path_length, read_kitti  # noqa: E402
 
 CONFIGS = (("no_loops", "base"), ("loops", "loops-1"))
 DETECTORS = (("visual", "visual"), ("lidar", "LiDAR"), ("proximity", "proximity"),
@@ -33,15 +32,8 @@ def estimates(folder):
     with open(path) as f:
         metrics = json.load(f)
     by_label = {e["label"]: e for e in metrics["estimates"]}
-    out = {}
-    for key, label in LABELS:
-        e = by_label.get(label)
-        out[key] = None if e is None else {
-            "ape_m": figure(e, "ape", "translation_m", "rmse"),
-            "ape_deg": figure(e, "ape", "rotation_deg", "rmse"),
-            "t_rel": figure(e, "kitti", "t_rel_percent"),
-        }
-    return out
+    return {key: estimate_figures(by_label[label]) if label in by_label else None
+            for key, label in LABELS}
 
 
 def detector_report(gt_dir, det):
@@ -67,9 +59,7 @@ def drive_row(run, name):
     if os.path.exists(gt_path):
         gt = read_kitti(gt_path)
         row["frames"] = len(gt)
-        row["length_m"] = sum(
-            math.dist([gt[k][i][3] for i in range(3)], [gt[k + 1][i][3] for i in range(3)])
-            for k in range(len(gt) - 1))
+        row["length_m"] = path_length(gt)
     for key, config in CONFIGS:
         row[key] = estimates(os.path.join(run, name, config))
     row["detectors"] = {det: detector_report(os.path.join(run, name, "gt"), det)
