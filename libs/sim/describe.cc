@@ -169,6 +169,8 @@ nlohmann::json DescribeScene(const World& world) {
                 {"motion_distortion", l.motion_distortion},
                 {"elevation_bias_deg", l.elevation_bias_deg},
                 {"height_m", world.options.lidar_height}};
+  // Recorded only when not the nominal one (scene.json of nominal drives stays as it was).
+  if (l.beam_table == BeamTable::kKitti04) j["lidar"]["beam_table"] = "kitti04";
   if (world.options.calib_error_deg != 0 || world.options.calib_error_m != 0) {
     const Rigid3d error = WrittenCalibrationError(world.options);
     j["calibration_error"] = {

@@ -15,6 +15,8 @@ void LidarOptions::Check() const {
   JVL_CHECK(beams >= 2 && beams <= 256, "beams must be in [2, 256], got " << beams);
   JVL_CHECK(elevation_max_deg > elevation_min_deg,
             "elevation_max_deg must exceed elevation_min_deg");
+  JVL_CHECK(beam_table != BeamTable::kKitti04 || beams == 64,
+            "the kitti04 beam table has 64 beams, got beams = " << beams);
   JVL_CHECK(azimuth_steps >= 16, "azimuth_steps must be >= 16, got " << azimuth_steps);
   JVL_CHECK(
       max_range > min_range && min_range >= 0,
@@ -28,7 +30,32 @@ void LidarOptions::Check() const {
   JVL_CHECK(sweep_period > 0, "sweep_period must be > 0, got " << sweep_period);
 }
 
+namespace {
+
+// Median elevation (deg) of each ring of the KITTI odometry 04 excerpt's 51 scans, highest ring
+// first: a ring is one turn of the azimuth from a scan's first point, the elevation that of the
+// point seen from the sensor origin (as a user of the .bin files sees it, with the sensor's own
+// per-laser corrections and its elevation error in it).
+constexpr double kKitti04RingElevationsDeg[64] = {
+    2.366,   2.001,   1.737,   1.284,   0.995,   0.596,   0.344,   -0.031,  -0.390,  -0.792,
+    -1.085,  -1.413,  -1.773,  -2.110,  -2.450,  -2.797,  -3.107,  -3.480,  -3.735,  -4.085,
+    -4.381,  -4.699,  -5.025,  -5.340,  -5.688,  -5.999,  -6.287,  -6.546,  -6.902,  -7.242,
+    -7.465,  -7.830,  -8.408,  -8.927,  -9.391,  -9.785,  -10.248, -10.855, -11.348, -11.768,
+    -12.215, -12.635, -13.160, -13.682, -14.251, -14.679, -15.186, -15.571, -16.198, -16.737,
+    -17.307, -17.767, -18.264, -18.691, -19.121, -19.691, -20.118, -20.789, -21.251, -21.672,
+    -22.103, -22.734, -23.169, -23.696};
+// The default elevation bias: kKitti04's beams are fired this much above the real rings.
+constexpr double kKitti04BeamRaiseDeg = 0.12;
+
+}  // namespace
+
 std::vector<double> LidarOptions::ElevationsRad() const {
+  if (beam_table == BeamTable::kKitti04) {
+    std::vector<double> e;
+    for (const double deg : kKitti04RingElevationsDeg)
+      e.push_back((deg + kKitti04BeamRaiseDeg) * kPi / 180.0);
+    return e;
+  }
   // Split point of the two laser blocks scaled from the HDL-64E's -8.33 / -8.83 deg.
   const double span = elevation_max_deg - elevation_min_deg;
   const double upper_end = elevation_max_deg - span * (10.33 / 26.9);

@@ -12,8 +12,16 @@
 
 namespace jvl::sim {
 
+// The beams' elevations. kNominal: the HDL-64E's two blocks of evenly spaced lasers between
+// elevation_max_deg and elevation_min_deg. kKitti04: the median elevation of each of the 64
+// rings of the real KITTI odometry 04 scans in ../shared/data (51 scans; 2.37 to -23.70 deg),
+// raised by the default elevation bias (0.12 deg), so that at the default bias the simulated
+// rings are reported at the real rings' elevations (docs/sim.md "Beam table").
+enum class BeamTable { kNominal, kKitti04 };
+
 struct LidarOptions {
   int beams = 64;
+  BeamTable beam_table = BeamTable::kNominal;
   double elevation_max_deg = 2.0;
   double elevation_min_deg = -24.9;
   int azimuth_steps = 2000;

@@ -85,6 +85,46 @@ TEST(LidarTest, BeamPatternIsHdl64Like) {
   EXPECT_GT(ground, 100);
 }
 
+// The kitti04 beam table: the real KITTI 04 rings' median elevations (2.366 to -23.696 deg) as
+// reported at the default bias, so the beams fire 0.12 deg above them; the lowest ring meets
+// the road 6 % farther from the sensor than the nominal table's -24.9 deg beam.
+TEST(LidarTest, Kitti04BeamTableHasTheRealRingsElevations) {
+  LidarOptions opt;
+  opt.beam_table = BeamTable::kKitti04;
+  const auto e = opt.ElevationsRad();
+  ASSERT_EQ(e.size(), 64u);
+  const double bias = opt.elevation_bias_deg;
+  EXPECT_NEAR(bias, 0.12, 1e-12);
+  EXPECT_NEAR(e.front() * 180 / M_PI - bias, 2.366, 1e-9);
+  EXPECT_NEAR(e[32] * 180 / M_PI - bias, -8.408, 1e-9);
+  EXPECT_NEAR(e.back() * 180 / M_PI - bias, -23.696, 1e-9);
+  for (size_t i = 1; i < e.size(); ++i) EXPECT_LT(e[i], e[i - 1]);
+
+  // Nearest road return in front of the car with each table: their distances are in the ratio
+  // of the lowest beams' cotangents, tan(24.9) / tan(23.576) = 1.064 (whatever the exact height
+  // of the sensor above the road there).
+  double nearest[2] = {1e9, 1e9};
+  for (const BeamTable table : {BeamTable::kNominal, BeamTable::kKitti04}) {
+    SequenceOptions so;
+    so.frames = 30;
+    so.seed = 7;
+    so.lidar.beam_table = table;
+    const auto world = BuildWorld(so);
+    const SimFrame f = SimulateFrame(*world, 0);
+    double& n = nearest[table == BeamTable::kKitti04 ? 1 : 0];
+    for (const auto& p : f.scan.points) {
+      if (p.x() > 0 && std::abs(p.y()) < 0.5 && std::abs(p.z() + 1.73) < 0.12)
+        n = std::min(n, p.head<2>().norm());
+    }
+  }
+  EXPECT_NEAR(nearest[0], 3.73, 0.08);
+  EXPECT_NEAR(nearest[1] / nearest[0],
+              std::tan(24.9 * M_PI / 180) / std::tan((23.696 - 0.12) * M_PI / 180), 0.004);
+
+  opt.beams = 32;
+  EXPECT_THROW(opt.Check(), std::exception);
+}
+
 // A dark square on an empty (sky) background appears centred on the projection of its centre.
 TEST(RenderTest, KnownPointProjectsToTheRightPixel) {
   const PinholeCamera cam = KittiCalibration().Camera(0);

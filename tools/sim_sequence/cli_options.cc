@@ -1,5 +1,8 @@
 #include "cli_options.h"
 
+#include <map>
+#include <string>
+
 #include "app/option_group.h"
 
 namespace jvl::tools {
@@ -31,6 +34,16 @@ void AddSimSequenceFlags(app::Tool& tool, sim::SequenceOptions* o) {
               "Report every LiDAR return this much (deg) below its beam, as the KITTI HDL-64E "
               "scans do (the default gives calib_check KITTI 04's pitch reading; lidar_odom "
               "--vertical-correction undoes it); 0: none");
+  static const std::map<std::string, sim::BeamTable> kBeamTables{
+      {"nominal", sim::BeamTable::kNominal}, {"kitti04", sim::BeamTable::kKitti04}};
+  sensors
+      .Add("--lidar-beams", "beam_table", o->lidar.beam_table,
+           "LiDAR beam elevations: nominal (the HDL-64E's two evenly spaced blocks, +2 to -24.9 "
+           "deg) or kitti04 (each ring at the median elevation of the real KITTI 04 scans' ring, "
+           "+2.37 to -23.70 deg as reported at the default --lidar-elevation-bias)")
+      ->transform(CLI::CheckedTransformer(kBeamTables, CLI::ignore_case).description(""))
+      ->type_name("{nominal,kitti04}")
+      ->default_str("nominal");
   sensors.Add("--calib-error-deg", "calib_error_deg", o->calib_error_deg,
               "Write calib.txt's camera-LiDAR extrinsic (Tr) rotated this much (deg) off the "
               "rig the data come from, about an axis drawn from the seed; 0: the true rig");
