@@ -46,8 +46,13 @@ def detector_report(gt_dir, det):
     # combined figures.
     entry = report["detectors"][-1]
     entry = dict(entry, keyframes=report["keyframes"], candidates=report["candidates"])
+    usage_path = os.path.join(gt_dir, det + ".usage.json")
     time_path = os.path.join(gt_dir, det + ".time")
-    if os.path.exists(time_path):
+    if os.path.exists(usage_path):
+        with open(usage_path) as f:
+            usage = json.load(f)
+        entry.update(time_s=usage["wall_s"], cpu_s=usage["cpu_s"], peak_mib=usage["peak_mib"])
+    elif os.path.exists(time_path):
         with open(time_path) as f:
             entry["time_s"] = float(f.read())
     return entry
@@ -77,17 +82,20 @@ def pct(a, b):
 
 
 def write_markdown(rows, path):
+    # The APE table holds the drives that went through the chain (not those of a
+    # pipelines/loops --detect-only run).
+    chain_rows = [r for r in rows if r.get("no_loops") or r.get("loops")]
     lines = [
         "| drive | frames | km | APE prior (m / deg) | no loops: w.o. / w. (m / deg) "
         "| loops: w.o. / w. (m / deg) | t_rel no loops -> loops, w.o. / w. (%) "
         "| loops / no loops, w.o. / w. |",
         "|---|---:|---:|---|---|---|---|---|",
-    ]
+    ] if chain_rows else []
 
     def ape(e):
         return "-" if not e else f"{fmt(e['ape_m'])} / {fmt(e['ape_deg'])}"
 
-    for r in rows:
+    for r in chain_rows:
         n, l = r.get("no_loops") or {}, r.get("loops") or {}
         km = f"{r['length_m'] / 1000:.2f}" if "length_m" in r else "-"
         t_rel = " / ".join(
@@ -102,33 +110,47 @@ def write_markdown(rows, path):
         "",
         "| drive | detector | keyframes | verified | accepted / right (precision) "
         "| recall same direction | recall opposite direction | stretches closed, same / opposite "
-        "| time (s, ms per keyframe) |",
-        "|---|---|---:|---:|---|---|---|---|---|",
+        "| time (s, ms per keyframe) | CPU (s), peak memory (MiB) |",
+        "|---|---|---:|---:|---|---|---|---|---|---|",
+    ] if chain_rows else [
+        "| drive | frames | km | detector | keyframes | verified "
+        "| accepted / right (precision) | recall same direction | recall opposite direction "
+        "| stretches closed, same / opposite | time (s, ms per keyframe) "
+        "| CPU (s), peak memory (MiB) |",
+        "|---|---:|---:|---|---:|---:|---|---|---|---|---|---|",
     ]
     for r in rows:
+        drive = r["name"]
+        if not chain_rows:
+            km = f"{r['length_m'] / 1000:.2f}" if "length_m" in r else "-"
+            drive = f"{r['name']} | {r.get('frames', '-')} | {km}"
         for det, label in DETECTORS:
             d = r["detectors"].get(det)
             if d is None:
-                lines.append(f"| {r['name']} | {label} | missing | | | | | | |")
+                lines.append(f"| {drive} | {label} | missing | | | | | | | |")
                 continue
             time = "-"
             if "time_s" in d:
                 time = f"{d['time_s']:.1f} ({1e3 * d['time_s'] / max(d['keyframes'], 1):.0f})"
+            usage = "-"
+            if "cpu_s" in d:
+                usage = f"{d['cpu_s']:.1f}, {d['peak_mib']:.0f}"
             lines.append(
-                f"| {r['name']} | {label} | {d['keyframes']} | {d['candidates']} "
+                f"| {drive} | {label} | {d['keyframes']} | {d['candidates']} "
                 f"| {d['accepted']} / {d['right']} ({pct(d['right'], d['accepted'])}) "
                 f"| {d['found_same']} of {d['revisits_same']} "
                 f"({pct(d['found_same'], d['revisits_same'])}) "
                 f"| {d['found_opposite']} of {d['revisits_opposite']} "
                 f"({pct(d['found_opposite'], d['revisits_opposite'])}) "
                 f"| {d['closed_same']} of {d['stretches_same']} / {d['closed_opposite']} of "
-                f"{d['stretches_opposite']} | {time} |")
+                f"{d['stretches_opposite']} | {time} | {usage} |")
     ratios = [r[f"ratio_{w}"] for r in rows for w in ("without", "with") if f"ratio_{w}" in r]
     wrong = sum(d["accepted"] - d["right"] for r in rows for d in r["detectors"].values() if d)
-    summary = (f"\nDrives ({len(rows)}): APE with loops / without loops {min(ratios):.2f}-"
-               f"{max(ratios):.2f} (mean {sum(ratios) / len(ratios):.2f}); wrong accepted loops "
-               f"(all runs of the second table) {wrong}.\n") if ratios else "\n"
-    text = "\n".join(lines) + "\n" + summary
+    ape = (f" APE with loops / without loops {min(ratios):.2f}-{max(ratios):.2f} (mean "
+           f"{sum(ratios) / len(ratios):.2f});") if ratios else ""
+    summary = (f"\nDrives ({len(rows)}):{ape} wrong accepted loops (all runs of the "
+               f"{'second ' if chain_rows else ''}table) {wrong}.\n")
+    text = "\n".join(lines).lstrip("\n") + "\n" + summary
     with open(path + ".tmp", "w") as f:
         f.write(text)
     os.replace(path + ".tmp", path)

@@ -21,6 +21,7 @@ JOBS_PY = os.path.join(ROOT, "pipelines", "jobs.py")
 COLLECT_PY = os.path.join(ROOT, "pipelines", "collect.py")
 GAINS_PY = os.path.join(ROOT, "pipelines", "gains_table.py")
 LOOPS_PY = os.path.join(ROOT, "pipelines", "loops_table.py")
+USAGE_PY = os.path.join(ROOT, "pipelines", "usage.py")
 FIDELITY_PY = os.path.join(ROOT, "scripts", "sim_fidelity.py")
 SLOW_BIAS_PY = os.path.join(ROOT, "scripts", "vp_slow_bias.py")
 SENSOR_FIDELITY_PY = os.path.join(ROOT, "scripts", "sensor_fidelity.py")
@@ -396,6 +397,149 @@ class LoopsTable(unittest.TestCase):
         self.assertIn("| d1 | proximity | missing |", md)
         self.assertIn("0.25-0.40 (mean 0.32); wrong accepted loops (all runs of the second "
                       "table) 1.", md)
+
+    def test_detect_only_run_has_the_detector_table_with_usage(self):
+        # pipelines/loops --detect-only: no chain, so no APE table; the drive's frames and length
+        # go into the detector table, with the CPU time and peak memory of usage.json.
+        shutil.rmtree(os.path.join(self.run_dir, "d1", "base"))
+        shutil.rmtree(os.path.join(self.run_dir, "d1", "loops-1"))
+        with open(os.path.join(self.run_dir, "d1", "gt", "all.usage.json"), "w") as f:
+            json.dump({"wall_s": 2.5, "cpu_s": 4.25, "peak_mib": 812.4, "exit_code": 0}, f)
+        out = run([sys.executable, LOOPS_PY, self.run_dir, "d1"])
+        self.assertEqual(out.returncode, 0, out.stderr)
+        md = read(os.path.join(self.run_dir, "loops.md"))
+        self.assertNotIn("APE prior", md)
+        self.assertTrue(md.startswith("| drive | frames | km | detector |"), md)
+        self.assertIn("| d1 | 11 | 0.02 | combined | 50 | 30 | 27 / 27 (100 %) | 19 of 20 (95 %) "
+                      "| 8 of 10 (80 %) | 1 of 1 / 1 of 1 | 2.5 (50) | 4.2, 812 |", md)
+        self.assertIn("| d1 | 11 | 0.02 | visual | 50 | 30 | 18 / 18 (100 %)", md)
+        self.assertIn("| 1.5 (30) | - |", md)
+        self.assertIn("Drives (1): wrong accepted loops (all runs of the table) 1.", md)
+        d1 = json.loads(read(os.path.join(self.run_dir, "loops.json")))[0]
+        self.assertIsNone(d1["no_loops"])
+        self.assertNotIn("ratio_without", d1)
+        self.assertEqual(d1["detectors"]["all"]["peak_mib"], 812.4)
+
+
+# A stand-in for every tool pipelines/loops --detect-only runs: writes each output it is given
+# (-o, --csv, --plot, --kitti-poses); sim_sequence also writes a ground truth of 11 poses 2 m
+# apart, loop_detect a --report with two right loops; visual_assoc fails on a drive named "bad".
+STUB_TOOL = r"""#!/usr/bin/env python3
+import json, os, sys
+tool, args = os.path.basename(sys.argv[0]), sys.argv[1:]
+if tool == "visual_assoc" and any("/bad/" in a for a in args):
+    sys.exit(tool + ": failing on purpose")
+def value(flag):
+    return args[args.index(flag) + 1] if flag in args else None
+if tool == "sim_sequence":
+    poses = os.path.join(value("-o"), "poses")
+    os.makedirs(poses, exist_ok=True)
+    os.makedirs(os.path.join(value("-o"), "sequences", "00"), exist_ok=True)
+    with open(os.path.join(poses, "00.txt"), "w") as f:
+        f.writelines(f"1 0 0 0 0 1 0 0 0 0 1 {2.0 * i}\n" for i in range(11))
+    with open(os.path.join(value("-o"), "..", "sim_calls"), "a") as f:
+        f.write(" ".join(args) + "\n")
+    sys.exit(0)
+for flag in ("-o", "--csv", "--plot", "--kitti-poses"):
+    if value(flag):
+        with open(value(flag), "w") as f:
+            f.write(tool + "\n")
+if tool == "loop_detect":
+    dets = value("--detectors").split(",")
+    entry = {"accepted": 2, "right": 2, "revisits_same": 0, "found_same": 0,
+             "revisits_opposite": 0, "found_opposite": 0, "stretches_same": 0, "closed_same": 0,
+             "stretches_opposite": 0, "closed_opposite": 0}
+    entries = [dict(entry, detector=d) for d in dets]
+    if len(dets) > 1:
+        entries.append(dict(entry, detector="combined"))
+    with open(value("--report"), "w") as f:
+        json.dump({"keyframes": 3, "candidates": 2, "accepted": 2, "detectors": entries}, f)
+"""
+
+
+class LoopsDetectOnly(unittest.TestCase):
+    """pipelines/loops --detect-only with stand-in tools: the drive list, the prior and visual
+    map through Makefile.example, the ground-truth runs with their usage, the table; a rerun
+    simulates nothing again; a failing drive fails the run and leaves the others' rows."""
+
+    def setUp(self):
+        self.dir = tempfile.mkdtemp()
+        self.bin = os.path.join(self.dir, "bin")
+        os.makedirs(self.bin)
+        for tool in ("sim_sequence", "lidar_odom", "vp_detect", "direction_cluster",
+                     "visual_assoc", "loop_detect"):
+            path = os.path.join(self.bin, tool)
+            with open(path, "w") as f:
+                f.write(STUB_TOOL)
+            os.chmod(path, 0o755)
+        self.drives = os.path.join(self.dir, "t.drives")
+        with open(self.drives, "w") as f:
+            f.write("# test drives\nd1   --scenario urban --seed 1\n\nd2 --seed 2 --laps 2\n")
+        self.run_dir = os.path.join(self.dir, "run")
+        self.env = dict(os.environ, JVL_BIN=self.bin, DRIVES=self.drives, THREADS="1")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def loops(self):
+        return run([os.path.join(ROOT, "pipelines", "loops"), self.run_dir, "--detect-only",
+                    "-j", "2"], env=self.env)
+
+    def test_detect_only_run(self):
+        out = self.loops()
+        self.assertEqual(out.returncode, 0, out.stdout + out.stderr)
+        for name in ("d1", "d2"):
+            for f in ("common/odom.h5", "common/vps.h5", "base/directions.h5", "base/visual.h5"):
+                self.assertTrue(os.path.exists(os.path.join(self.run_dir, name, f)), f)
+            for det in ("visual", "lidar", "proximity", "all"):
+                usage = json.loads(read(os.path.join(self.run_dir, name, "gt",
+                                                     det + ".usage.json")))
+                self.assertEqual(usage["exit_code"], 0)
+        md = read(os.path.join(self.run_dir, "loops.md"))
+        self.assertNotIn("APE prior", md)
+        self.assertIn("| d2 | 11 | 0.02 | combined | 3 | 2 | 2 / 2 (100 %) |", md)
+        self.assertIn("Drives (2): wrong accepted loops (all runs of the table) 0.", md)
+        calls = read(os.path.join(self.run_dir, "data", "sim_calls")).splitlines()
+        self.assertEqual(len(calls), 2)
+        self.assertIn("--seed 2 --laps 2", calls[1])
+        # A rerun finds the drives simulated and every artifact up to date.
+        out = self.loops()
+        self.assertEqual(out.returncode, 0, out.stdout + out.stderr)
+        self.assertNotIn("simulating", out.stdout)
+        self.assertEqual(len(read(os.path.join(self.run_dir, "data", "sim_calls")).splitlines()), 2)
+
+    def test_a_failing_drive_fails_the_run(self):
+        with open(self.drives, "a") as f:
+            f.write("bad --seed 3\n")
+        out = self.loops()
+        self.assertNotEqual(out.returncode, 0)
+        self.assertIn("bad", out.stderr)
+        md = read(os.path.join(self.run_dir, "loops.md"))
+        self.assertIn("| d1 | 11 | 0.02 | combined |", md)
+        self.assertIn("| bad | 11 | 0.02 | visual | missing |", md)
+
+
+class Usage(unittest.TestCase):
+    """pipelines/usage.py: a command's wall and CPU time and peak memory, and its exit code."""
+
+    def test_figures_and_exit_code(self):
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "u.json")
+            # 64 MiB held while the process spins for a CPU second.
+            code = ("import time\nx = bytearray(64 << 20)\nt = time.process_time()\n"
+                    "while time.process_time() - t < 0.3: pass\nraise SystemExit(3)")
+            res = run([sys.executable, USAGE_PY, out, "--", sys.executable, "-c", code])
+            self.assertEqual(res.returncode, 3, res.stderr)
+            figures = json.loads(read(out))
+            self.assertEqual(figures["exit_code"], 3)
+            self.assertGreaterEqual(figures["cpu_s"], 0.3)
+            self.assertGreaterEqual(figures["wall_s"], 0.3)
+            self.assertGreater(figures["peak_mib"], 64)
+            res = run([sys.executable, USAGE_PY, out, "--", os.path.join(d, "missing")])
+            self.assertEqual(res.returncode, 127)
+            self.assertIn("cannot run", res.stderr)
+            res = run([sys.executable, USAGE_PY, out])
+            self.assertEqual(res.returncode, 2)
 
 
 class SimFidelity(unittest.TestCase):
