@@ -16,7 +16,7 @@ namespace jvl::sim {
 // elevation_max_deg and elevation_min_deg. kKitti04: the median elevation of each of the 64
 // rings of the real KITTI odometry 04 scans in ../shared/data (51 scans; 2.37 to -23.70 deg),
 // raised by the default elevation bias (0.12 deg), so that at the default bias the simulated
-// rings are reported at the real rings' elevations (docs/sim.md "Beam table").
+// rings are reported at the real rings' elevations (docs/sim.md, `--lidar-beams`).
 enum class BeamTable { kNominal, kKitti04 };
 
 struct LidarOptions {
