@@ -262,6 +262,10 @@ struct SolveOptions {
   // dense matrix avoids the sparse one's per-cell lookups (13 % less local mapping time on the
   // demo drive, same result within 3e-5 m); global problems have thousands of poses.
   int dense_schur_max_blocks = 64;
+  // The dense case is solved by this project's Levenberg-Marquardt (schur_lm.h: the same step
+  // control and stopping rules as Ceres', without Ceres' per-solve preparation and per-cell
+  // locks) instead of Ceres' DENSE_SCHUR. false: Ceres, for comparison.
+  bool schur_lm = true;
   void Check() const;
 };
 

@@ -168,13 +168,14 @@ TEST(JointProblem, DropsObservationsBehindTheCameraAndFixesTheFirstPoseByDefault
   EXPECT_TRUE(jp.problem->IsParameterBlockConstant(jp.poses.at(0).data()));
   EXPECT_FALSE(jp.problem->IsParameterBlockConstant(jp.poses.at(1).data()));
   const JointSolveResult result = SolveJointProblem(jp, {});
-  EXPECT_EQ(result.linear_solver, "DENSE_SCHUR");  // a handful of poses
+  EXPECT_EQ(result.linear_solver, "SCHUR_LM");  // a handful of poses: the dense native solver
   EXPECT_TRUE(result.usable);
 }
 
 TEST(JointProblem, DenseAndSparseSchurComplementsGiveTheSameSolution) {
   ToyRoad toy = MakeToyRoad(false);
   SolveOptions dense, sparse;
+  dense.schur_lm = false;  // Ceres' dense Schur complement (schur_lm_test.cc: the native one)
   sparse.dense_schur_max_blocks = 0;
   const JointSolveResult a = OptimizeJoint(toy.input, {}, dense);
   const JointSolveResult b = OptimizeJoint(toy.input, {}, sparse);

@@ -10,6 +10,7 @@
 #include "core/check.h"
 #include "core/timer.h"
 #include "optim/joint_problem.h"
+#include "optim/schur_lm.h"
 
 namespace jvl::optim {
 namespace {
@@ -160,7 +161,30 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   ProgressLog progress(options.progress_label);
   if (!options.progress_label.empty()) so.callbacks.push_back(&progress);
   ceres::Solver::Summary summary;
-  if (jp.problem->NumResidualBlocks() > 0) {
+  std::vector<double*> points;
+  if (options.schur_lm && so.linear_solver_type == ceres::DENSE_SCHUR) {
+    for (auto& point : jp.map_points) {
+      if (jp.problem->HasParameterBlock(point.data())) points.push_back(point.data());
+    }
+    if (!SchurLmApplies(*jp.problem, points, kPoseTangentSize * options.dense_schur_max_blocks))
+      points.clear();
+  }
+  if (!points.empty()) {
+    SchurLmOptions lm;
+    lm.max_iterations = options.max_iterations;
+    lm.function_tolerance = options.function_tolerance;
+    lm.gradient_tolerance = options.gradient_tolerance;
+    lm.parameter_tolerance = options.parameter_tolerance;
+    lm.max_time_s = options.max_time_s;
+    lm.progress_label = options.progress_label;
+    const SchurLmSummary s = SolveSchurLm(*jp.problem, points, lm);
+    result.iterations = s.iterations;
+    result.usable = s.usable;
+    result.termination = s.report;
+    if (!options.evaluate_before) result.before.total = s.initial_cost;
+    summary.final_cost = s.final_cost;
+    result.linear_solver = "SCHUR_LM";
+  } else if (jp.problem->NumResidualBlocks() > 0) {
     ceres::Solve(so, jp.problem.get(), &summary);
     result.iterations = static_cast<int>(summary.iterations.size()) - 1;
     result.usable = summary.IsSolutionUsable();
@@ -170,7 +194,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
     result.usable = true;
     result.termination = "no residuals";
   }
-  result.linear_solver = ceres::LinearSolverTypeToString(so.linear_solver_type);
+  if (points.empty()) result.linear_solver = ceres::LinearSolverTypeToString(so.linear_solver_type);
   phase.Reset();
   if (options.evaluate_after || !result.usable) {
     result.after = EvaluateJointCost(jp);
