@@ -453,7 +453,8 @@ void SchurLm::BuildNormalEquations() {
           const double* ar = ja + row * ca.tangent;
           const double* br = jacobians_.data() + sb.jacobian + row * cb.tangent;
           for (int j = 0; j < cb.tangent; ++j) {
-            double* column = u_.data() + static_cast<ptrdiff_t>(cb.offset + j) * reduced_ + ca.offset;
+            double* column =
+                u_.data() + static_cast<ptrdiff_t>(cb.offset + j) * reduced_ + ca.offset;
             const double bj = br[j];
             for (int i = 0; i < ca.tangent; ++i) column[i] += ar[i] * bj;
           }
@@ -728,7 +729,8 @@ SchurLmSummary SchurLm::Run() {
     const double relative_decrease = change / model_change;
     if (relative_decrease > kMinRelativeDecrease) {
       ++summary.successful_steps;
-      radius = std::min(kMaxRadius, radius / std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * relative_decrease - 1.0, 3)));
+      const double shrink = 1.0 - std::pow(2.0 * relative_decrease - 1.0, 3);
+      radius = std::min(kMaxRadius, radius / std::max(1.0 / 3.0, shrink));
       decrease_factor = 2.0;
       SaveValues();
       if (!Evaluate(true, &cost, &fixed)) {
