@@ -103,6 +103,22 @@ class SchurLm {
   double ApplyStep(const Eigen::VectorXd& delta);
   double GradientMaxNorm() const;
   int PointColumn(int p) const { return reduced_ + 3 * p; }
+  // Multiplies r's Jacobian columns by the Jacobi scaling scale_.
+  void ScaleColumns(const Residual& r);
+  // Calls fn(tangent, column, jacobian) for each non-constant parameter block of r in slot order:
+  // its tangent size, its first column in the step and its Jacobian's offset in jacobians_
+  // (row-major, r.rows x tangent).
+  template <typename Fn>
+  void ForEachFreeBlock(const Residual& r, Fn&& fn) const {
+    for (int k = 0; k < r.num_slots; ++k) {
+      const Slot& s = slots_[r.first_slot + k];
+      if (s.kind == Kind::kConstant) continue;
+      if (s.kind == Kind::kPoint)
+        fn(3, PointColumn(s.index), s.jacobian);
+      else
+        fn(cameras_[s.index].tangent, cameras_[s.index].offset, s.jacobian);
+    }
+  }
 
   ceres::Problem& problem_;
   const SchurLmOptions options_;
@@ -342,11 +358,8 @@ bool SchurLm::Evaluate(bool jacobians, double* cost_free, double* cost_fixed) {
         residual_scaling = sqrt_rho1 / (1.0 - alpha);
         alpha_sq_norm = alpha / sq;
       }
-      for (int k = 0; k < r.num_slots; ++k) {
-        const Slot& s = slots_[r.first_slot + k];
-        if (s.kind == Kind::kConstant) continue;
-        const int tangent = s.kind == Kind::kPoint ? 3 : cameras_[s.index].tangent;
-        double* j = jacobians_.data() + s.jacobian;
+      ForEachFreeBlock(r, [&](int tangent, int /*col*/, int offset) {
+        double* j = jacobians_.data() + offset;
         if (alpha_sq_norm != 0.0) {
           for (int t = 0; t < tangent; ++t) {
             double ftj = 0.0;
@@ -356,52 +369,37 @@ bool SchurLm::Evaluate(bool jacobians, double* cost_free, double* cost_fixed) {
           }
         }
         for (int i = 0; i < r.rows * tangent; ++i) j[i] *= sqrt_rho1;
-      }
+      });
       for (int i = 0; i < r.rows; ++i) f[i] *= residual_scaling;
     }
     // Jacobi scaling (known after the first Jacobian): columns times scale_.
-    if (scale_.size() == 0) continue;
-    for (int k = 0; k < r.num_slots; ++k) {
-      const Slot& s = slots_[r.first_slot + k];
-      if (s.kind == Kind::kConstant) continue;
-      const int tangent = s.kind == Kind::kPoint ? 3 : cameras_[s.index].tangent;
-      const int col = s.kind == Kind::kPoint ? PointColumn(s.index) : cameras_[s.index].offset;
-      double* j = jacobians_.data() + s.jacobian;
-      const double* sc = scale_.data() + col;
-      for (int row = 0; row < r.rows; ++row)
-        for (int t = 0; t < tangent; ++t) j[row * tangent + t] *= sc[t];
-    }
+    if (scale_.size() > 0) ScaleColumns(r);
   }
   if (!jacobians || scale_.size() > 0) return true;
   // Jacobi scaling, fixed at the first Jacobian (as Ceres does): columns divided by 1 + norm.
   col_norm_.setZero();
   for (const Residual& r : residuals_) {
     if (!r.free) continue;
-    for (int k = 0; k < r.num_slots; ++k) {
-      const Slot& s = slots_[r.first_slot + k];
-      if (s.kind == Kind::kConstant) continue;
-      const int tangent = s.kind == Kind::kPoint ? 3 : cameras_[s.index].tangent;
-      const int col = s.kind == Kind::kPoint ? PointColumn(s.index) : cameras_[s.index].offset;
-      const double* j = jacobians_.data() + s.jacobian;
+    ForEachFreeBlock(r, [&](int tangent, int col, int offset) {
+      const double* j = jacobians_.data() + offset;
       for (int row = 0; row < r.rows; ++row)
         for (int t = 0; t < tangent; ++t)
           col_norm_[col + t] += j[row * tangent + t] * j[row * tangent + t];
-    }
+    });
   }
   scale_ = (1.0 + col_norm_.array().sqrt()).inverse().matrix();
-  for (const Residual& r : residuals_) {
-    if (!r.free) continue;
-    for (int k = 0; k < r.num_slots; ++k) {
-      const Slot& s = slots_[r.first_slot + k];
-      if (s.kind == Kind::kConstant) continue;
-      const int tangent = s.kind == Kind::kPoint ? 3 : cameras_[s.index].tangent;
-      const int col = s.kind == Kind::kPoint ? PointColumn(s.index) : cameras_[s.index].offset;
-      double* j = jacobians_.data() + s.jacobian;
-      for (int row = 0; row < r.rows; ++row)
-        for (int t = 0; t < tangent; ++t) j[row * tangent + t] *= scale_[col + t];
-    }
-  }
+  for (const Residual& r : residuals_)
+    if (r.free) ScaleColumns(r);
   return true;
+}
+
+void SchurLm::ScaleColumns(const Residual& r) {
+  ForEachFreeBlock(r, [&](int tangent, int col, int offset) {
+    double* j = jacobians_.data() + offset;
+    const double* sc = scale_.data() + col;
+    for (int row = 0; row < r.rows; ++row)
+      for (int t = 0; t < tangent; ++t) j[row * tangent + t] *= sc[t];
+  });
 }
 
 void SchurLm::BuildNormalEquations() {
@@ -572,15 +570,11 @@ double SchurLm::ModelCostChange(const Eigen::VectorXd& step) const {
     if (!r.free) continue;
     JVL_CHECK(r.rows <= 64, "residual block with more than 64 residuals");
     std::fill(jd, jd + r.rows, 0.0);
-    for (int k = 0; k < r.num_slots; ++k) {
-      const Slot& s = slots_[r.first_slot + k];
-      if (s.kind == Kind::kConstant) continue;
-      const int tangent = s.kind == Kind::kPoint ? 3 : cameras_[s.index].tangent;
-      const int col = s.kind == Kind::kPoint ? PointColumn(s.index) : cameras_[s.index].offset;
-      const double* j = jacobians_.data() + s.jacobian;
+    ForEachFreeBlock(r, [&](int tangent, int col, int offset) {
+      const double* j = jacobians_.data() + offset;
       for (int row = 0; row < r.rows; ++row)
         for (int t = 0; t < tangent; ++t) jd[row] += j[row * tangent + t] * step[col + t];
-    }
+    });
     const double* f = f_.data() + r.row;
     for (int row = 0; row < r.rows; ++row) change -= jd[row] * (f[row] + 0.5 * jd[row]);
   }
