@@ -22,10 +22,13 @@ class OptionGroup {
     return cli_.add_option(flags, value, help)->capture_default_str()->group(name_);
   }
 
-  // A switch; "--name,!--no-name" gives both spellings, and then --help shows the default.
+  // A switch; "--name,!--no-name" gives both spellings, and then --help names the default
+  // ("(default: on)"). The provenance records the value it leaves.
   CLI::Option* Flag(const std::string& flags, bool& value, const std::string& help) {
-    CLI::Option* option = cli_.add_flag(flags, value, help)->group(name_);
-    if (flags.find(',') != std::string::npos) option->capture_default_str();
+    const bool both = flags.find(',') != std::string::npos;
+    const std::string text = both ? help + (value ? " (default: on)" : " (default: off)") : help;
+    CLI::Option* option = cli_.add_flag(flags, value, text)->group(name_);
+    tool_.Switch(option, &value);
     return option;
   }
 

@@ -231,6 +231,8 @@ void Tool::AddInput(const std::string& path, bool same_dataset) {
   }
 }
 
+void Tool::Switch(const CLI::Option* option, const bool* value) { switches_[option] = value; }
+
 nlohmann::json Tool::OptionsJson() const {
   nlohmann::json j = nlohmann::json::object();
   for (const CLI::Option* opt : cli_.get_options()) {
@@ -241,10 +243,13 @@ nlohmann::json Tool::OptionsJson() const {
       const std::string def = opt->get_default_str();
       if (!def.empty()) values.push_back(def);
     }
-    if (opt->get_expected_max() > 1 || values.size() > 1) {
+    const auto sw = switches_.find(opt);
+    if (sw != switches_.end()) {
+      j[name] = *sw->second;
+    } else if (opt->get_expected_max() == 0) {  // a flag without --no-: on if given
+      j[name] = !opt->results().empty() && opt->results().back() == "true";
+    } else if (opt->get_expected_max() > 1 || values.size() > 1) {
       j[name] = values;
-    } else if (opt->get_type_size() == 0) {
-      j[name] = opt->count() > 0;  // A flag.
     } else {
       j[name] = values.empty() ? std::string() : values[0];
     }

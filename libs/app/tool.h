@@ -47,6 +47,9 @@ class Tool {
   // tool's error line a field is shown as its flag: the flag spelled like the field
   // (--samples-per-list) if the tool has one, else the flag given here.
   void FieldFlag(const std::string& field, const std::string& flag);
+  // A switch whose variable the provenance records by value (the value it holds after parsing,
+  // whether set by --x, --no-x or left at its default).
+  void Switch(const CLI::Option* option, const bool* value);
 
   // Adds the options every tool that opens a dataset has: --format, --lidar, --gt-source and
   // --calib (io::DatasetOptions; the reader checks the values and the layout they apply to).
@@ -79,6 +82,7 @@ class Tool {
   CLI::App cli_;
   std::vector<CLI::Option*> output_options_, input_options_;
   std::map<std::string, std::string> field_flags_;
+  std::map<const CLI::Option*, const bool*> switches_;
   int threads_ = 0;
   std::string log_level_ = "info";
   bool quiet_ = false;

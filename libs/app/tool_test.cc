@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "app/option_group.h"
 #include "core/check.h"
@@ -209,6 +210,28 @@ TEST(OptionGroup, GroupsDefaultsAndFieldNames) {
   EXPECT_EQ(tool.Run(3, argv, [] { JVL_THROW("kernel_h must be > 0, got 0"); }), 1);
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "demo: error: --imls-h must be > 0, got 0\n");
   EXPECT_EQ(samples, 3);
+}
+
+// A switch with both spellings is recorded by the value it leaves, not by whether it was given,
+// and --help names the default in words (CLI11's "--x,--no-x{false}" only says what --no-x sets).
+TEST(OptionGroup, SwitchesRecordTheirValue) {
+  for (const auto& [args, expected] :
+       std::vector<std::pair<std::vector<const char*>, bool>>{
+           {{"demo"}, true}, {{"demo", "--deskew"}, true}, {{"demo", "--no-deskew"}, false}}) {
+    Tool tool("demo", "d");
+    bool deskew = true;
+    bool verbose = false;
+    OptionGroup group(tool, "Registration");
+    group.Flag("--deskew,!--no-deskew", deskew, "Deskew scans");
+    group.Flag("--verbose", verbose, "Talk");
+    EXPECT_EQ(tool.Run(static_cast<int>(args.size()), args.data(), [] {}), 0);
+    EXPECT_EQ(deskew, expected);
+    const auto j = tool.OptionsJson();
+    EXPECT_EQ(j["deskew"], expected) << args.back();
+    EXPECT_EQ(j["verbose"], false);
+    const std::string help = tool.cli().help();
+    EXPECT_NE(help.find("Deskew scans (default: on)"), std::string::npos) << help;
+  }
 }
 
 }  // namespace
