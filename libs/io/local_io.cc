@@ -1,5 +1,8 @@
 #include "io/local_io.h"
 
+#include <utility>
+#include <vector>
+
 #include "core/check.h"
 #include "io/camera_io.h"
 #include "io/trajectory_io.h"
@@ -15,7 +18,9 @@ void CheckSize(const std::vector<T>& v, size_t n, const char* name, const std::s
 
 }  // namespace
 
-void LocalMapData::Check(const std::string& what) const {
+void LocalMapData::Check(const std::string& what) const { Check(what, LocalMapParts::kAll); }
+
+void LocalMapData::Check(const std::string& what, LocalMapParts parts) const {
   keyframes.Check((what + " keyframes").c_str());
   const size_t k = keyframes.size(), l = num_correspondences(), s = num_scan_points();
   CheckSize(imls_c, l, "imls/c", what);
@@ -24,14 +29,19 @@ void LocalMapData::Check(const std::string& what) const {
   CheckSize(imls_normal, 3 * l, "imls/normal", what);
   JVL_CHECK(mappoint_position.size() % 3 == 0, what << ": mappoints/position is not M x 3");
   CheckSize(scan_offset, k + 1, "scans/offset", what);
-  CheckSize(scan_normals, 3 * s, "scans/normals", what);
-  JVL_CHECK(scan_points.size() == 3 * s, what << ": scans/points is not S x 3");
   for (size_t i = 0; i < k; ++i) {
     JVL_CHECK(scan_offset[i] <= scan_offset[i + 1],
               what << ": scans/offset decreases at keyframe row " << i);
   }
-  JVL_CHECK(scan_offset.front() == 0 && scan_offset.back() == static_cast<int64_t>(s),
-            what << ": scans/offset must run from 0 to " << s);
+  if (parts == LocalMapParts::kWithoutScans) {
+    JVL_CHECK(scan_points.empty() && scan_normals.empty() && scan_offset.front() == 0,
+              what << ": scans/offset must start at 0 (scans not read)");
+  } else {
+    CheckSize(scan_normals, 3 * s, "scans/normals", what);
+    JVL_CHECK(scan_points.size() == 3 * s, what << ": scans/points is not S x 3");
+    JVL_CHECK(scan_offset.front() == 0 && scan_offset.back() == static_cast<int64_t>(s),
+              what << ": scans/offset must run from 0 to " << s);
+  }
   for (size_t i = 0; i < l; ++i) {
     JVL_CHECK(imls_n[i] >= 0 && imls_c[i] >= 0 && static_cast<size_t>(imls_n[i]) < k &&
                   static_cast<size_t>(imls_c[i]) < k,
@@ -81,7 +91,7 @@ LocalMapData ReadLocalMap(const std::string& path, LocalMapParts parts) {
   d.camera = ReadCameraArray(r, "camera");
   d.camera_choice = ReadCameraChoice(r);
   d.keyframes = ReadTrajectoryGroup(r, "keyframes");
-  if (parts == LocalMapParts::kAll) {
+  if (parts != LocalMapParts::kWithoutCorrespondences) {
     d.imls_n = r.ReadArray<int32_t>("imls/n");
     d.imls_c = r.ReadArray<int32_t>("imls/c");
     d.imls_p_x = r.ReadArray<double>("imls/p_x", 3);
@@ -90,8 +100,10 @@ LocalMapData ReadLocalMap(const std::string& path, LocalMapParts parts) {
     d.mappoint_position = r.ReadArray<double>("mappoints/position", 3);
   }
   d.scan_offset = r.ReadArray<int64_t>("scans/offset");
-  d.scan_points = r.ReadArray<float>("scans/points", 3);
-  d.scan_normals = r.ReadArray<float>("scans/normals", 3);
+  if (parts != LocalMapParts::kWithoutScans) {
+    d.scan_points = r.ReadArray<float>("scans/points", 3);
+    d.scan_normals = r.ReadArray<float>("scans/normals", 3);
+  }
   d.stats_frame = r.ReadArray<int64_t>("stats/frame");
   d.stats_visual_residuals = r.ReadArray<int32_t>("stats/visual_residuals");
   d.stats_imls_residuals = r.ReadArray<int32_t>("stats/imls_residuals");
@@ -100,8 +112,35 @@ LocalMapData ReadLocalMap(const std::string& path, LocalMapParts parts) {
   d.stats_time_ms = r.ReadArray<double>("stats/time_ms");
   d.prior = ReadTrajectoryGroup(r, "prior");
   d.summary = r.ReadJson("summary");
-  d.Check(path);
+  d.Check(path, parts);
   return d;
+}
+
+void ReadLocalScans(const std::string& path, const LocalScanSink& sink, int64_t rows_per_block) {
+  JVL_CHECK(rows_per_block > 0, "rows_per_block must be positive (got " << rows_per_block << ")");
+  H5Reader r(path, kLocalSchema, kLocalSchemaVersion);
+  const std::vector<int64_t> offset = r.ReadArray<int64_t>("scans/offset");
+  const std::vector<int64_t> points = r.Dims("scans/points"), normals = r.Dims("scans/normals");
+  JVL_CHECK(points.size() == 2 && points[1] == 3, path << ": scans/points is not S x 3");
+  JVL_CHECK(normals == points, path << ": scans/normals and scans/points differ in shape");
+  JVL_CHECK(!offset.empty() && offset.front() == 0 && offset.back() == points[0],
+            path << ": scans/offset must run from 0 to " << points[0]);
+  const size_t k = offset.size() - 1;
+  for (size_t i = 0; i < k; ++i) {
+    JVL_CHECK(offset[i] <= offset[i + 1], path << ": scans/offset decreases at keyframe row " << i);
+  }
+  for (size_t first = 0; first < k;) {
+    size_t last = first + 1;
+    while (last < k && offset[last + 1] - offset[first] <= rows_per_block) ++last;
+    const std::vector<std::pair<int64_t, int64_t>> rows = {{offset[first], offset[last]}};
+    const std::vector<float> p = r.ReadRows<float>("scans/points", rows, 3);
+    const std::vector<float> n = r.ReadRows<float>("scans/normals", rows, 3);
+    for (size_t i = first; i < last; ++i) {
+      const size_t at = 3 * static_cast<size_t>(offset[i] - offset[first]);
+      sink(i, p.data() + at, n.data() + at, static_cast<size_t>(offset[i + 1] - offset[i]));
+    }
+    first = last;
+  }
 }
 
 }  // namespace jvl::io

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <vector>
 
 #include "core/check.h"
 #include "core/temp_dir.h"
@@ -90,6 +91,55 @@ TEST(LocalIo, ReadsWithoutCorrespondences) {
   EXPECT_EQ(r.scan_normals, d.scan_normals);
   EXPECT_EQ(r.stats_frame, d.stats_frame);
   EXPECT_EQ(r.prior.frames, d.prior.frames);
+  fs::remove(path);
+}
+
+TEST(LocalIo, ReadsWithoutScans) {
+  const LocalMapData d = MakeLocal();
+  const std::string path = TempPath("noscans.h5");
+  WriteLocalMap(path, d, Provenance{});
+  const LocalMapData r = ReadLocalMap(path, LocalMapParts::kWithoutScans);
+  EXPECT_TRUE(r.scan_points.empty() && r.scan_normals.empty());
+  EXPECT_EQ(r.scan_offset, d.scan_offset);
+  EXPECT_EQ(r.imls_n, d.imls_n);
+  EXPECT_EQ(r.imls_p_y, d.imls_p_y);
+  EXPECT_EQ(r.mappoint_position, d.mappoint_position);
+  EXPECT_EQ(r.stats_frame, d.stats_frame);
+  fs::remove(path);
+}
+
+// Whatever the block size, the streamed scans are the file's rows, keyframe by keyframe.
+TEST(LocalIo, StreamsScansInBlocks) {
+  LocalMapData d = MakeLocal();
+  // A third keyframe with an empty scan between two with points.
+  d.keyframes.Append(7, Rigid3d());
+  d.scan_offset = {0, 2, 2, 3};
+  d.stats_frame.push_back(7);
+  d.stats_visual_residuals.push_back(1);
+  d.stats_imls_residuals.push_back(2);
+  d.stats_cost_before.push_back(1);
+  d.stats_cost_after.push_back(0.5);
+  d.stats_time_ms.push_back(90);
+  const std::string path = TempPath("stream.h5");
+  WriteLocalMap(path, d, Provenance{});
+  for (const int64_t block : {1, 2, 3, 1000}) {
+    std::vector<size_t> keyframes;
+    std::vector<float> points, normals;
+    ReadLocalScans(
+        path,
+        [&](size_t keyframe, const float* p, const float* n, size_t rows) {
+          EXPECT_EQ(rows, static_cast<size_t>(d.scan_offset[keyframe + 1] -
+                                              d.scan_offset[keyframe]));
+          keyframes.push_back(keyframe);
+          points.insert(points.end(), p, p + 3 * rows);
+          normals.insert(normals.end(), n, n + 3 * rows);
+        },
+        block);
+    EXPECT_EQ(keyframes, (std::vector<size_t>{0, 1, 2})) << "block " << block;
+    EXPECT_EQ(points, d.scan_points) << "block " << block;
+    EXPECT_EQ(normals, d.scan_normals) << "block " << block;
+  }
+  EXPECT_THROW(ReadLocalScans(path, [](size_t, const float*, const float*, size_t) {}, 0), Error);
   fs::remove(path);
 }
 

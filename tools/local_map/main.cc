@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <utility>
 
 #include "app/tool.h"
 #include "cli_options.h"
@@ -80,7 +81,7 @@ int main(int argc, char** argv) {
         io::ResolveVerticalCorrection(vertical_correction, *dataset);
     scan_options.Check();
     Progress progress("local_map", static_cast<int64_t>(input.size()), !tool.quiet());
-    const mapping::LocalMappingResult result = mapping::RunLocalMapping(
+    mapping::LocalMappingResult result = mapping::RunLocalMapping(
         input,
         [&](size_t row) {
           const PointCloud scan = dataset->LoadScan(input.frames[row]);
@@ -116,7 +117,9 @@ int main(int argc, char** argv) {
           progress.Tick();
         });
     const nlohmann::json summary = mapping::SummarizeLocalMap(result, options);
-    io::WriteLocalMap(output, mapping::ExportLocalMap(input, result, prior, summary),
+    // The result's scans and correspondences move into the artifact's arrays (not copied next
+    // to them); its poses stay for the KITTI poses.
+    io::WriteLocalMap(output, mapping::ExportLocalMap(input, std::move(result), prior, summary),
                       tool.MakeProvenance());
     if (!kitti_poses.empty()) {
       io::WriteTrajectoryKitti(kitti_poses, mapping::RefinedKeyframes(input, result));

@@ -36,9 +36,8 @@ std::vector<lidar::StoredScan> ScansOf(const io::LocalMapData& d) {
   return scans;
 }
 
-}  // namespace
-
-StoredLocalMap ToStoredLocalMap(const io::LocalMapData& d) {
+// Everything of the artifact but the scans.
+StoredLocalMap WithoutScans(const io::LocalMapData& d) {
   StoredLocalMap out;
   out.keyframes = d.keyframes;
   out.imls.reserve(d.num_correspondences());
@@ -48,17 +47,44 @@ StoredLocalMap ToStoredLocalMap(const io::LocalMapData& d) {
   out.mappoints.reserve(d.num_mappoints());
   for (size_t i = 0; i < d.num_mappoints(); ++i)
     out.mappoints.push_back(Row3(d.mappoint_position, i));
-  out.scans = ScansOf(d);
   out.prior = d.prior;
   return out;
 }
 
+}  // namespace
+
+StoredLocalMap ToStoredLocalMap(const io::LocalMapData& d) {
+  StoredLocalMap out = WithoutScans(d);
+  out.scans = ScansOf(d);
+  return out;
+}
+
 StoredLocalMap ReadStoredLocalMap(const std::string& path) {
-  return ToStoredLocalMap(io::ReadLocalMap(path));
+  // The scans are streamed into their own layout, and the file's flat correspondence arrays are
+  // gone before they are read: on a 4500-frame drive holding both copies of both took global_opt
+  // past 2 GiB.
+  StoredLocalMap out = WithoutScans(io::ReadLocalMap(path, io::LocalMapParts::kWithoutScans));
+  out.scans = ReadStoredScans(path);
+  JVL_CHECK(out.scans.size() == out.keyframes.size(),
+            path << ": " << out.scans.size() << " stored scans for " << out.keyframes.size()
+                 << " keyframes (was the file replaced while it was read?)");
+  return out;
 }
 
 std::vector<lidar::StoredScan> ReadStoredScans(const std::string& path) {
-  return ScansOf(io::ReadLocalMap(path, io::LocalMapParts::kWithoutCorrespondences));
+  std::vector<lidar::StoredScan> scans;
+  io::ReadLocalScans(path, [&](size_t keyframe, const float* points, const float* normals,
+                               size_t rows) {
+    scans.resize(keyframe + 1);
+    lidar::StoredScan& s = scans[keyframe];
+    s.points.resize(rows);
+    s.normals.resize(rows);
+    for (size_t j = 0; j < rows; ++j) {
+      s.points[j] = Eigen::Vector3f(points[3 * j], points[3 * j + 1], points[3 * j + 2]);
+      s.normals[j] = Eigen::Vector3f(normals[3 * j], normals[3 * j + 1], normals[3 * j + 2]);
+    }
+  });
+  return scans;
 }
 
 GlobalMapInput AssembleGlobalInput(const io::VisualMapData& visual, StoredLocalMap&& local,

@@ -24,5 +24,11 @@ LocalMappingInput MakeLocalMappingInput(const io::VisualMapData& visual, const T
 // The "local" artifact layout; `prior` is stored as the full prior trajectory.
 io::LocalMapData ExportLocalMap(const LocalMappingInput& input, const LocalMappingResult& result,
                                 const Trajectory& prior, const nlohmann::json& summary);
+// The same, consuming the result's correspondences and scans (left empty) as they are copied:
+// the artifact's flat arrays then replace them instead of adding to the peak memory (local_map on
+// a 4500-frame drive: 3.4 million correspondences and 22.5 million scan points, 0.8 GB). The
+// poses, map points and stats stay.
+io::LocalMapData ExportLocalMap(const LocalMappingInput& input, LocalMappingResult&& result,
+                                const Trajectory& prior, const nlohmann::json& summary);
 
 }  // namespace jvl::mapping
