@@ -51,7 +51,10 @@ void ReadAs(const std::string& schema, const std::string& path) {
   if (schema == "vps") ReadVpsArtifact(path);
   if (schema == "directions") ReadDirectionsArtifact(path);
   if (schema == "visual") ReadVisualMap(path);
-  if (schema == "local") ReadLocalMap(path);
+  if (schema == "local") {
+    ReadLocalMap(path);
+    ReadLocalScans(path, [](size_t, const float*, const float*, size_t) {});
+  }
   if (schema == "global") ReadGlobalArtifact(path);
 }
 

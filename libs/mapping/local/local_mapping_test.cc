@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include "mapping/local/local_artifact.h"
 #include "mapping/local/local_scan.h"
@@ -275,6 +276,22 @@ TEST(LocalMapping, ExactPriorStaysPut) {
   EXPECT_EQ(data.scan_offset.size(), 9u);
   EXPECT_EQ(data.num_correspondences(), run.result.correspondences.size());
   EXPECT_EQ(data.num_mappoints(), run.input.map_points.size());
+  // Consuming the result gives the same arrays and leaves its scans and correspondences empty.
+  LocalMappingResult moved = run.result;
+  const io::LocalMapData consumed = ExportLocalMap(run.input, std::move(moved), Trajectory(), {});
+  EXPECT_TRUE(moved.scans.empty() && moved.correspondences.empty());
+  EXPECT_EQ(moved.poses.size(), run.result.poses.size());
+  EXPECT_EQ(consumed.imls_n, data.imls_n);
+  EXPECT_EQ(consumed.imls_c, data.imls_c);
+  EXPECT_EQ(consumed.imls_p_x, data.imls_p_x);
+  EXPECT_EQ(consumed.imls_p_y, data.imls_p_y);
+  EXPECT_EQ(consumed.imls_normal, data.imls_normal);
+  EXPECT_EQ(consumed.mappoint_position, data.mappoint_position);
+  EXPECT_EQ(consumed.scan_offset, data.scan_offset);
+  EXPECT_EQ(consumed.scan_points, data.scan_points);
+  EXPECT_EQ(consumed.scan_normals, data.scan_normals);
+  EXPECT_EQ(consumed.stats_frame, data.stats_frame);
+  EXPECT_GT(data.num_scan_points(), 0u);
 }
 
 }  // namespace
