@@ -60,15 +60,15 @@ std::vector<int64_t> VisualMapData::CovisibilityPartStarts() const {
   return starts;
 }
 
-void VisualMapData::Check(const std::string& what) const {
+void VisualMapData::Check(const std::string& what, bool descriptors) const {
   keyframes.Check((what + " keyframes").c_str());
   const size_t p = num_keypoints(), m = num_mappoints(), o = num_observations(), e = num_edges();
   CheckSize(keypoint_uv, 2 * p, "keypoints/uv", what);
   CheckSize(keypoint_octave, p, "keypoints/octave", what);
   CheckSize(keypoint_angle, p, "keypoints/angle", what);
-  CheckSize(keypoint_descriptor, 32 * p, "keypoints/descriptor", what);
+  CheckSize(keypoint_descriptor, descriptors ? 32 * p : 0, "keypoints/descriptor", what);
   CheckSize(mappoint_position, 3 * m, "mappoints/position", what);
-  CheckSize(mappoint_descriptor, 32 * m, "mappoints/descriptor", what);
+  CheckSize(mappoint_descriptor, descriptors ? 32 * m : 0, "mappoints/descriptor", what);
   CheckSize(mappoint_normal, 3 * m, "mappoints/normal", what);
   CheckSize(observation_keyframe, o, "observations/keyframe", what);
   CheckSize(observation_keypoint, o, "observations/keypoint", what);
@@ -149,7 +149,8 @@ VisualMapData ReadVisualMapHeader(const std::string& path) {
   return d;
 }
 
-VisualMapData ReadVisualMap(const std::string& path) {
+VisualMapData ReadVisualMap(const std::string& path, VisualMapParts parts) {
+  const bool descriptors = parts == VisualMapParts::kAll;
   H5Reader r(path, kVisualSchema, kVisualSchemaVersion);
   VisualMapData d;
   d.camera = ReadCameraArray(r, "camera");
@@ -158,9 +159,9 @@ VisualMapData ReadVisualMap(const std::string& path) {
   d.keypoint_uv = r.ReadArray<float>("keypoints/uv", 2);
   d.keypoint_octave = r.ReadArray<int32_t>("keypoints/octave");
   d.keypoint_angle = r.ReadArray<float>("keypoints/angle");
-  d.keypoint_descriptor = r.ReadArray<uint8_t>("keypoints/descriptor", 32);
+  if (descriptors) d.keypoint_descriptor = r.ReadArray<uint8_t>("keypoints/descriptor", 32);
   d.mappoint_position = r.ReadArray<double>("mappoints/position", 3);
-  d.mappoint_descriptor = r.ReadArray<uint8_t>("mappoints/descriptor", 32);
+  if (descriptors) d.mappoint_descriptor = r.ReadArray<uint8_t>("mappoints/descriptor", 32);
   d.mappoint_normal = r.ReadArray<double>("mappoints/normal", 3);
   d.observation_keyframe = r.ReadArray<int32_t>("observations/keyframe");
   d.observation_keypoint = r.ReadArray<int32_t>("observations/keypoint");
@@ -169,7 +170,7 @@ VisualMapData ReadVisualMap(const std::string& path) {
   d.covisibility_weight = r.ReadArray<int32_t>("covisibility/weight");
   d.prior = ReadTrajectoryGroup(r, "prior");
   d.summary = r.ReadJson("summary");
-  d.Check(path);
+  d.Check(path, descriptors);
   return d;
 }
 

@@ -79,6 +79,30 @@ TEST(VisualIo, RoundTrip) {
   fs::remove(path);
 }
 
+// Without descriptors: everything else as in the whole map, both descriptor arrays empty.
+TEST(VisualIo, ReadsWithoutDescriptors) {
+  const VisualMapData d = MakeMap();
+  const std::string path = TempPath("nodesc.h5").string();
+  WriteVisualMap(path, d, Provenance{});
+  const VisualMapData r = ReadVisualMap(path, VisualMapParts::kWithoutDescriptors);
+  EXPECT_TRUE(r.keypoint_descriptor.empty());
+  EXPECT_TRUE(r.mappoint_descriptor.empty());
+  EXPECT_FALSE(d.keypoint_descriptor.empty());
+  EXPECT_EQ(r.keypoint_keyframe, d.keypoint_keyframe);
+  EXPECT_EQ(r.keypoint_uv, d.keypoint_uv);
+  EXPECT_EQ(r.keypoint_octave, d.keypoint_octave);
+  EXPECT_EQ(r.mappoint_position, d.mappoint_position);
+  EXPECT_EQ(r.mappoint_normal, d.mappoint_normal);
+  EXPECT_EQ(r.observation_keyframe, d.observation_keyframe);
+  EXPECT_EQ(r.observation_keypoint, d.observation_keypoint);
+  EXPECT_EQ(r.observation_mappoint, d.observation_mappoint);
+  EXPECT_EQ(r.covisibility_edges, d.covisibility_edges);
+  EXPECT_EQ(r.prior.frames, d.prior.frames);
+  // A map read so cannot be written back (the writer wants the descriptors).
+  EXPECT_THROW(WriteVisualMap(TempPath("nodesc2.h5").string(), r, Provenance{}), Error);
+  fs::remove(path);
+}
+
 // The header holds the same camera choice, pyramid and keyframes as the whole map, and nothing
 // else.
 TEST(VisualIo, HeaderIsTheMapsHead) {

@@ -86,7 +86,8 @@ int main(int argc, char** argv) {
     const Timer reading;
     {
       tool.AddInput(visual_path);
-      const auto visual = io::ReadVisualMap(visual_path);
+      // Positions and octaves of the keypoints only: the descriptors are not used here.
+      const auto visual = io::ReadVisualMap(visual_path, io::VisualMapParts::kWithoutDescriptors);
       JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to optimise)");
       tool.AddInput(local_path);
       auto local = mapping::ReadStoredLocalMap(local_path);

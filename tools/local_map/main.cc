@@ -58,11 +58,12 @@ int main(int argc, char** argv) {
     options.Check();
     scan_options.Check();
     tool.AddInput(visual_path);
-    // The visual artifact (its keypoints and descriptors are most of it: about 0.4 GiB on a
-    // 4000-keyframe drive) is released once the input is assembled.
+    // The visual artifact is read without its descriptors (not used here; with them it took about
+    // 0.4 GiB on a 4000-keyframe drive) and released once the input is assembled.
     Trajectory prior;
     const mapping::LocalMappingInput input = [&] {
-      const io::VisualMapData visual = io::ReadVisualMap(visual_path);
+      const io::VisualMapData visual =
+          io::ReadVisualMap(visual_path, io::VisualMapParts::kWithoutDescriptors);
       JVL_CHECK(!visual.keyframes.empty(), visual_path << ": no keyframes (nothing to refine)");
       io::WarnIfCovisibilitySplit(visual, visual_path);
       prior = visual.prior;
