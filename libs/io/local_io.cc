@@ -16,9 +16,19 @@ void CheckSize(const std::vector<T>& v, size_t n, const char* name, const std::s
             what << ": " << name << " has " << v.size() << " values, expected " << n);
 }
 
-}  // namespace
+// scans/offset of K keyframes: K + 1 values, non-decreasing, from 0 to `points` rows.
+void CheckScanOffsets(const std::vector<int64_t>& offset, size_t k, int64_t points,
+                      const std::string& what) {
+  CheckSize(offset, k + 1, "scans/offset", what);
+  for (size_t i = 0; i < k; ++i) {
+    JVL_CHECK(offset[i] <= offset[i + 1],
+              what << ": scans/offset decreases at keyframe row " << i);
+  }
+  JVL_CHECK(offset.front() == 0 && offset.back() == points,
+            what << ": scans/offset must run from 0 to " << points);
+}
 
-void LocalMapData::Check(const std::string& what) const { Check(what, LocalMapParts::kAll); }
+}  // namespace
 
 void LocalMapData::Check(const std::string& what, LocalMapParts parts) const {
   keyframes.Check((what + " keyframes").c_str());
@@ -28,19 +38,15 @@ void LocalMapData::Check(const std::string& what, LocalMapParts parts) const {
   CheckSize(imls_p_y, 3 * l, "imls/p_y", what);
   CheckSize(imls_normal, 3 * l, "imls/normal", what);
   JVL_CHECK(mappoint_position.size() % 3 == 0, what << ": mappoints/position is not M x 3");
-  CheckSize(scan_offset, k + 1, "scans/offset", what);
-  for (size_t i = 0; i < k; ++i) {
-    JVL_CHECK(scan_offset[i] <= scan_offset[i + 1],
-              what << ": scans/offset decreases at keyframe row " << i);
-  }
   if (parts == LocalMapParts::kWithoutScans) {
-    JVL_CHECK(scan_points.empty() && scan_normals.empty() && scan_offset.front() == 0,
-              what << ": scans/offset must start at 0 (scans not read)");
+    JVL_CHECK(scan_points.empty() && scan_normals.empty(),
+              what << ": scans/points and scans/normals were not to be read");
+    // Their row count is not known here; ReadLocalScans checks the offsets against it.
+    CheckScanOffsets(scan_offset, k, scan_offset.empty() ? 0 : scan_offset.back(), what);
   } else {
     CheckSize(scan_normals, 3 * s, "scans/normals", what);
     JVL_CHECK(scan_points.size() == 3 * s, what << ": scans/points is not S x 3");
-    JVL_CHECK(scan_offset.front() == 0 && scan_offset.back() == static_cast<int64_t>(s),
-              what << ": scans/offset must run from 0 to " << s);
+    CheckScanOffsets(scan_offset, k, static_cast<int64_t>(s), what);
   }
   for (size_t i = 0; i < l; ++i) {
     JVL_CHECK(imls_n[i] >= 0 && imls_c[i] >= 0 && static_cast<size_t>(imls_n[i]) < k &&
@@ -123,12 +129,9 @@ void ReadLocalScans(const std::string& path, const LocalScanSink& sink, int64_t 
   const std::vector<int64_t> points = r.Dims("scans/points"), normals = r.Dims("scans/normals");
   JVL_CHECK(points.size() == 2 && points[1] == 3, path << ": scans/points is not S x 3");
   JVL_CHECK(normals == points, path << ": scans/normals and scans/points differ in shape");
-  JVL_CHECK(!offset.empty() && offset.front() == 0 && offset.back() == points[0],
-            path << ": scans/offset must run from 0 to " << points[0]);
+  JVL_CHECK(!offset.empty(), path << ": scans/offset is empty");
   const size_t k = offset.size() - 1;
-  for (size_t i = 0; i < k; ++i) {
-    JVL_CHECK(offset[i] <= offset[i + 1], path << ": scans/offset decreases at keyframe row " << i);
-  }
+  CheckScanOffsets(offset, k, points[0], path);
   for (size_t first = 0; first < k;) {
     size_t last = first + 1;
     while (last < k && offset[last + 1] - offset[first] <= rows_per_block) ++last;

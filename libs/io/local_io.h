@@ -31,7 +31,11 @@ namespace jvl::io {
 inline constexpr const char* kLocalSchema = "local";
 inline constexpr int kLocalSchemaVersion = 1;
 
-enum class LocalMapParts;
+// What ReadLocalMap reads. kWithoutCorrespondences leaves out the saved IMLS set and the map
+// points (imls_* and mappoint_position stay empty): most of the file on long sequences, and all
+// a map export does not need. kWithoutScans leaves out scans/points and scans/normals (scan_offset
+// is read): ReadLocalScans streams them.
+enum class LocalMapParts { kAll, kWithoutCorrespondences, kWithoutScans };
 
 // Flat arrays laid out exactly as in the file (row-major).
 struct LocalMapData {
@@ -54,15 +58,8 @@ struct LocalMapData {
   size_t num_scan_points() const { return scan_points.size() / 3; }
   // Sizes agree and indices are in range; throws naming `what`. With kWithoutScans the points
   // and normals are not expected (scan_offset is still checked but for its last value).
-  void Check(const std::string& what) const;
-  void Check(const std::string& what, LocalMapParts parts) const;
+  void Check(const std::string& what, LocalMapParts parts = LocalMapParts::kAll) const;
 };
-
-// What ReadLocalMap reads. kWithoutCorrespondences leaves out the saved IMLS set and the map
-// points (imls_* and mappoint_position stay empty): most of the file on long sequences, and all
-// a map export does not need. kWithoutScans leaves out scans/points and scans/normals (scan_offset
-// is read): ReadLocalScans streams them.
-enum class LocalMapParts { kAll, kWithoutCorrespondences, kWithoutScans };
 
 void WriteLocalMap(const std::string& path, const LocalMapData& data, const Provenance& provenance);
 LocalMapData ReadLocalMap(const std::string& path, LocalMapParts parts = LocalMapParts::kAll);

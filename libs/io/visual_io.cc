@@ -60,7 +60,8 @@ std::vector<int64_t> VisualMapData::CovisibilityPartStarts() const {
   return starts;
 }
 
-void VisualMapData::Check(const std::string& what, bool descriptors) const {
+void VisualMapData::Check(const std::string& what, VisualMapParts parts) const {
+  const bool descriptors = parts == VisualMapParts::kAll;
   keyframes.Check((what + " keyframes").c_str());
   const size_t p = num_keypoints(), m = num_mappoints(), o = num_observations(), e = num_edges();
   CheckSize(keypoint_uv, 2 * p, "keypoints/uv", what);
@@ -170,7 +171,7 @@ VisualMapData ReadVisualMap(const std::string& path, VisualMapParts parts) {
   d.covisibility_weight = r.ReadArray<int32_t>("covisibility/weight");
   d.prior = ReadTrajectoryGroup(r, "prior");
   d.summary = r.ReadJson("summary");
-  d.Check(path, descriptors);
+  d.Check(path, parts);
   return d;
 }
 

@@ -28,6 +28,12 @@ namespace jvl::io {
 inline constexpr const char* kVisualSchema = "visual";
 inline constexpr int kVisualSchemaVersion = 1;
 
+// What ReadVisualMap reads. kWithoutDescriptors leaves keypoint_descriptor and
+// mappoint_descriptor empty: the stages after visual_assoc (local_map, global_opt) use the
+// keypoints' positions and octaves only, and the descriptors take 32 bytes for each of the
+// millions of keypoints of a long drive.
+enum class VisualMapParts { kAll, kWithoutDescriptors };
+
 // Flat arrays laid out exactly as in the file (row-major).
 struct VisualMapData {
   PinholeCamera camera;
@@ -53,9 +59,9 @@ struct VisualMapData {
   size_t num_mappoints() const { return mappoint_position.size() / 3; }
   size_t num_observations() const { return observation_mappoint.size(); }
   size_t num_edges() const { return covisibility_weight.size(); }
-  // Sizes agree and all indices are in range; throws naming `what`. `descriptors` false: both
-  // descriptor arrays must be empty (read without them).
-  void Check(const std::string& what, bool descriptors = true) const;
+  // Sizes agree and all indices are in range; throws naming `what`. With kWithoutDescriptors
+  // both descriptor arrays must be empty.
+  void Check(const std::string& what, VisualMapParts parts = VisualMapParts::kAll) const;
   // Connected parts of the covisibility graph: the frame of the first keyframe of each part, in
   // keyframe order (one entry when the graph is connected, none without keyframes).
   std::vector<int64_t> CovisibilityPartStarts() const;
@@ -67,12 +73,6 @@ void WarnIfCovisibilitySplit(const VisualMapData& data, const std::string& path)
 
 void WriteVisualMap(const std::string& path, const VisualMapData& data,
                     const Provenance& provenance);
-// What ReadVisualMap reads. kWithoutDescriptors leaves keypoint_descriptor and
-// mappoint_descriptor empty: the stages after visual_assoc (local_map, global_opt) use the
-// keypoints' positions and octaves only, and the descriptors are a third of a long drive's map
-// (a 4500-frame drive: 32 bytes for each of millions of keypoints).
-enum class VisualMapParts { kAll, kWithoutDescriptors };
-
 VisualMapData ReadVisualMap(const std::string& path, VisualMapParts parts = VisualMapParts::kAll);
 // Only camera_choice, scale_factor, num_levels and keyframes of a visual map, the rest left empty
 // (a fraction of a second where the whole map can take seconds).

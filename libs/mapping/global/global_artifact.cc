@@ -15,23 +15,28 @@ Eigen::Vector3d Row3(const std::vector<T>& a, size_t i) {
   return Eigen::Vector3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
 }
 
-// The stored scans (single precision, as in the file), one per keyframe; all empty if the file
-// has none.
+// One keyframe's stored scan from its float x y z rows (single precision, as in the file); sized
+// up front: grown by push_back, the scans of a long sequence took up to twice their size.
+lidar::StoredScan ScanOfRows(const float* points, const float* normals, size_t rows) {
+  lidar::StoredScan scan;
+  scan.points.reserve(rows);
+  scan.normals.reserve(rows);
+  for (size_t j = 0; j < 3 * rows; j += 3) {
+    scan.points.emplace_back(points[j], points[j + 1], points[j + 2]);
+    scan.normals.emplace_back(normals[j], normals[j + 1], normals[j + 2]);
+  }
+  return scan;
+}
+
+// The stored scans, one per keyframe; all empty if the data has none.
 std::vector<lidar::StoredScan> ScansOf(const io::LocalMapData& d) {
   const size_t k = d.keyframes.size();
   std::vector<lidar::StoredScan> scans(k);
   if (d.scan_offset.empty()) return scans;
   for (size_t i = 0; i < k; ++i) {
-    // Sized up front: grown by push_back, the scans of a long sequence took up to twice their size.
-    const auto count = static_cast<size_t>(d.scan_offset[i + 1] - d.scan_offset[i]);
-    scans[i].points.reserve(count);
-    scans[i].normals.reserve(count);
-    for (int64_t j = d.scan_offset[i]; j < d.scan_offset[i + 1]; ++j) {
-      const size_t r = 3 * static_cast<size_t>(j);
-      scans[i].points.emplace_back(d.scan_points[r], d.scan_points[r + 1], d.scan_points[r + 2]);
-      scans[i].normals.emplace_back(d.scan_normals[r], d.scan_normals[r + 1],
-                                    d.scan_normals[r + 2]);
-    }
+    const size_t at = 3 * static_cast<size_t>(d.scan_offset[i]);
+    scans[i] = ScanOfRows(d.scan_points.data() + at, d.scan_normals.data() + at,
+                          static_cast<size_t>(d.scan_offset[i + 1] - d.scan_offset[i]));
   }
   return scans;
 }
@@ -73,16 +78,8 @@ StoredLocalMap ReadStoredLocalMap(const std::string& path) {
 
 std::vector<lidar::StoredScan> ReadStoredScans(const std::string& path) {
   std::vector<lidar::StoredScan> scans;
-  io::ReadLocalScans(path, [&](size_t keyframe, const float* points, const float* normals,
-                               size_t rows) {
-    scans.resize(keyframe + 1);
-    lidar::StoredScan& s = scans[keyframe];
-    s.points.resize(rows);
-    s.normals.resize(rows);
-    for (size_t j = 0; j < rows; ++j) {
-      s.points[j] = Eigen::Vector3f(points[3 * j], points[3 * j + 1], points[3 * j + 2]);
-      s.normals[j] = Eigen::Vector3f(normals[3 * j], normals[3 * j + 1], normals[3 * j + 2]);
-    }
+  io::ReadLocalScans(path, [&](size_t, const float* points, const float* normals, size_t rows) {
+    scans.push_back(ScanOfRows(points, normals, rows));  // keyframes come in order
   });
   return scans;
 }
