@@ -111,6 +111,10 @@ class PointToImlsCost {
 // both in k's frame (found at the start of the round). Together with the point's reprojections
 // it fixes how far the cameras moved also where the scans alone cannot (a street without cross
 // structure), as a depth measurement would.
+// The block has two residuals, [r, 0]: every residual block on a map point then has the size of
+// a reprojection error (2), so Ceres' Schur elimination runs its code specialised for 2 x 3 x 6
+// blocks instead of the generic dynamic-size one it falls back to when the sizes differ (the
+// cost and its derivatives are those of r alone; JointSolveResult::schur_structure).
 class PointToSurfaceCost {
  public:
   PointToSurfaceCost(const Eigen::Vector3d& k_p_y, const Eigen::Vector3d& k_normal,
@@ -124,12 +128,13 @@ class PointToSurfaceCost {
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> x_w(point);
     const Eigen::Matrix<T, 3, 1> x_k = q_wk.conjugate() * (x_w - t_wk);
     residual[0] = T(sqrt_information_) * (x_k - k_p_y_.cast<T>()).dot(k_normal_.cast<T>());
+    residual[1] = T(0);
     return true;
   }
 
   static ceres::CostFunction* Create(const Eigen::Vector3d& k_p_y, const Eigen::Vector3d& k_normal,
                                      double sqrt_information) {
-    return new ceres::AutoDiffCostFunction<PointToSurfaceCost, 1, 7, 3>(
+    return new ceres::AutoDiffCostFunction<PointToSurfaceCost, 2, 7, 3>(
         new PointToSurfaceCost(k_p_y, k_normal, sqrt_information));
   }
 

@@ -295,6 +295,9 @@ struct JointSolveResult {
   bool usable = false;      // Ceres returned CONVERGENCE or NO_CONVERGENCE (not FAILURE)
   std::string termination;  // Ceres' summary line
   std::string linear_solver;
+  // Block sizes (rows, map point, pose) of the Schur elimination Ceres used for a Schur-type
+  // solve, "2,3,6" when it ran its specialised code, "d,d,d" for the generic one; empty otherwise.
+  std::string schur_structure;
   std::map<int64_t, Rigid3d> poses;              // optimised world_from_cam
   std::vector<Eigen::Vector3d> map_points;       // optimised (unchanged if not optimised)
   std::vector<Eigen::Vector3d> free_directions;  // optimised free d_w blocks (unit)

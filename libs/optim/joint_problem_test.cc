@@ -477,6 +477,17 @@ TEST(JointProblem, SurfaceTermFixesTheSpacingInACorridorTheScansCannotSee) {
   JointProblemOptions held;
   held.optimize_map_points = false;
   EXPECT_TRUE(BuildJointProblem(in, held).surface_blocks.empty());
+
+  // Solved as global problems are (SPARSE_SCHUR), the same result; every residual block on a
+  // map point has two rows (the surface block pads its one with a zero), so Ceres eliminates the
+  // points with its code specialised for 2 x 3 x 6 blocks, not the generic dynamic-size one.
+  SolveOptions sparse;
+  sparse.dense_schur_max_blocks = 0;
+  const JointSolveResult global = OptimizeJoint(in, {}, sparse);
+  ASSERT_TRUE(global.usable);
+  EXPECT_EQ(global.linear_solver, "SPARSE_SCHUR");
+  EXPECT_EQ(global.schur_structure, "2,3,6");
+  EXPECT_LT(spacing_error(global), 0.01) << spacing_error(global) << " m";
 }
 
 }  // namespace

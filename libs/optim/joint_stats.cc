@@ -189,6 +189,7 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
     result.iterations = static_cast<int>(summary.iterations.size()) - 1;
     result.usable = summary.IsSolutionUsable();
     result.termination = summary.BriefReport();
+    result.schur_structure = summary.schur_structure_used;
     if (!options.evaluate_before) result.before.total = summary.initial_cost;
   } else {
     result.usable = true;
@@ -205,11 +206,12 @@ JointSolveResult SolveJointProblem(JointProblem& jp, const SolveOptions& options
   spdlog::debug(
       "joint solve: cost by term {:.1f} s before, {:.1f} s after; Ceres preprocessor {:.1f} s, "
       "minimizer {:.1f} s (Jacobians {:.1f} s, residuals {:.1f} s, linear solver {:.1f} s), "
-      "postprocessor {:.1f} s",
+      "postprocessor {:.1f} s; Schur structure {}",
       before_s, phase.ElapsedSeconds(), summary.preprocessor_time_in_seconds,
       summary.minimizer_time_in_seconds, summary.jacobian_evaluation_time_in_seconds,
       summary.residual_evaluation_time_in_seconds, summary.linear_solver_time_in_seconds,
-      summary.postprocessor_time_in_seconds);
+      summary.postprocessor_time_in_seconds,
+      result.schur_structure.empty() ? "-" : result.schur_structure);
   for (const auto& [id, block] : jp.poses) result.poses[id] = FromPoseBlock(block);
   result.map_points.reserve(jp.map_points.size());
   for (const auto& p : jp.map_points) result.map_points.emplace_back(p[0], p[1], p[2]);
